@@ -1,0 +1,1 @@
+"""sila_labware package."""

@@ -1,0 +1,1 @@
+"""tiago_sim package."""
