@@ -1,0 +1,190 @@
+"""The robot as the SiLA side sees it: named actions, services and state topics of labware_interfaces.
+
+This is the back end under the SiLA feature implementations. It knows the ROS names of the
+contract (/navigate_to_poi, /get_labware, /robot_state, ...) and converts messages into the
+plain snapshots of `workcell.py`. It knows nothing of the simulation: a real robot that serves
+the same names works unchanged.
+
+Threads: construct and call from any thread except the ROS thread; every wait is on a future
+with a timeout. Listeners registered here run on the ROS thread.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable, Sequence
+
+from labware_interfaces.action import Dock, GetLabware, NavigateToPoi, PutLabware, Undock
+from labware_interfaces.msg import RobotState, StationStates
+from labware_interfaces.srv import CheckPlacement, DescribeWorkcell
+
+from ros_bridge.actions import ActionCaller, ActionGoal, GoalProgress
+from ros_bridge.runtime import RosRuntime
+from ros_bridge.services import ServiceCaller
+from ros_bridge.topics import TopicMirror
+from ros_bridge.workcell import (
+    HotelSlotContent,
+    NestOccupancy,
+    PlacementCheck,
+    RobotStatus,
+    StationDescription,
+    WorkcellDescription,
+)
+
+logger = logging.getLogger(__name__)
+
+FeedbackListener = Callable[[GoalProgress], None]
+
+
+def robot_status_from_message(message: RobotState) -> RobotStatus:
+    return RobotStatus(
+        state=message.state,
+        detail=message.detail,
+        current_poi=message.current_poi,
+        x_m=float(message.base_pose.x),
+        y_m=float(message.base_pose.y),
+        theta_rad=float(message.base_pose.theta),
+        hotel=tuple(
+            HotelSlotContent(int(slot.index), slot.labware_id, slot.labware_type) for slot in message.hotel
+        ),
+        held_labware_id=message.held_labware_id,
+    )
+
+
+def nest_occupancies_from_message(message: StationStates) -> tuple[NestOccupancy, ...]:
+    return tuple(
+        NestOccupancy(nest.station, int(nest.sub_position), bool(nest.occupied), nest.labware_id)
+        for nest in message.nests
+    )
+
+
+class RobotLink:
+    """Clients of every robot-side action, service and topic, sharing one `RosRuntime`."""
+
+    def __init__(self, runtime: RosRuntime) -> None:
+        self.runtime = runtime
+        self._navigate = ActionCaller(runtime, NavigateToPoi, "/navigate_to_poi")
+        self._dock = ActionCaller(runtime, Dock, "/dock")
+        self._undock = ActionCaller(runtime, Undock, "/undock")
+        self._get_labware = ActionCaller(runtime, GetLabware, "/get_labware")
+        self._put_labware = ActionCaller(runtime, PutLabware, "/put_labware")
+        self._describe = ServiceCaller(runtime, DescribeWorkcell, "/describe_workcell")
+        self._check_placement = ServiceCaller(runtime, CheckPlacement, "/check_placement")
+        self._robot_state = TopicMirror(runtime, RobotState, "/robot_state")
+        self._station_states = TopicMirror(runtime, StationStates, "/station_states")
+
+    def wait_until_ready(self, timeout_s: float = 30.0) -> None:
+        """Wait for every action server, service and state topic; raise ServerUnavailable naming one."""
+        for action in (self._navigate, self._dock, self._undock, self._get_labware, self._put_labware):
+            action.wait_for_server(timeout_s)
+        for service in (self._describe, self._check_placement):
+            service.wait_for_service(timeout_s)
+        self._robot_state.wait_for_message(timeout_s)
+        self._station_states.wait_for_message(timeout_s)
+
+    # --- actions: each returns a goal handle at once (wait on it, cancel it) ---
+
+    def navigate_to_poi(self, poi: str, on_feedback: FeedbackListener | None = None) -> ActionGoal:
+        return self._navigate.send(NavigateToPoi.Goal(poi=poi), on_feedback)
+
+    def dock(self, on_feedback: FeedbackListener | None = None) -> ActionGoal:
+        return self._dock.send(Dock.Goal(), on_feedback)
+
+    def undock(self, on_feedback: FeedbackListener | None = None) -> ActionGoal:
+        return self._undock.send(Undock.Goal(), on_feedback)
+
+    def get_labware(
+        self,
+        station: str,
+        sub_position: int,
+        hotel_slot: int,
+        labware_type: str,
+        labware_id: str,
+        intermediate_actions: Sequence[str] = (),
+        on_feedback: FeedbackListener | None = None,
+    ) -> ActionGoal:
+        goal = GetLabware.Goal(
+            handover_position=station,
+            sub_position=sub_position,
+            internal_position=hotel_slot,
+            labware_type=labware_type,
+            labware_id=labware_id,
+            intermediate_actions=list(intermediate_actions),
+        )
+        return self._get_labware.send(goal, on_feedback)
+
+    def put_labware(
+        self,
+        station: str,
+        sub_position: int,
+        hotel_slot: int,
+        labware_type: str,
+        labware_id: str,
+        intermediate_actions: Sequence[str] = (),
+        on_feedback: FeedbackListener | None = None,
+    ) -> ActionGoal:
+        goal = PutLabware.Goal(
+            handover_position=station,
+            sub_position=sub_position,
+            internal_position=hotel_slot,
+            labware_type=labware_type,
+            labware_id=labware_id,
+            intermediate_actions=list(intermediate_actions),
+        )
+        return self._put_labware.send(goal, on_feedback)
+
+    # --- services ---
+
+    def describe_workcell(self, timeout_s: float = 5.0) -> WorkcellDescription:
+        response = self._describe.call(DescribeWorkcell.Request(), timeout_s)
+        return WorkcellDescription(
+            stations=tuple(
+                StationDescription(station.name, int(station.sub_positions), station.poi)
+                for station in response.stations
+            ),
+            hotel_slots=int(response.hotel_slots),
+            pois=tuple(response.pois),
+            dock_poi=response.dock_poi,
+        )
+
+    def check_placement(
+        self, labware_id: str, station: str = "", sub_position: int = 0, timeout_s: float = 5.0
+    ) -> PlacementCheck:
+        request = CheckPlacement.Request(labware_id=labware_id, station=station, sub_position=sub_position)
+        response = self._check_placement.call(request, timeout_s)
+        return PlacementCheck(
+            found=bool(response.found),
+            in_nest=bool(response.in_nest),
+            position_error_m=float(response.position_error_m),
+            yaw_error_rad=float(response.yaw_error_rad),
+            location=response.location,
+        )
+
+    # --- state topics ---
+
+    def robot_status(self, timeout_s: float = 5.0) -> RobotStatus:
+        """The latest robot state (waits for the first message up to `timeout_s`)."""
+        return robot_status_from_message(self._robot_state.wait_for_message(timeout_s))
+
+    def latest_robot_status(self) -> RobotStatus | None:
+        message = self._robot_state.latest
+        return None if message is None else robot_status_from_message(message)
+
+    def nest_occupancies(self, timeout_s: float = 5.0) -> tuple[NestOccupancy, ...]:
+        return nest_occupancies_from_message(self._station_states.wait_for_message(timeout_s))
+
+    def wait_for_robot_status(
+        self, predicate: Callable[[RobotStatus], bool], timeout_s: float = 5.0
+    ) -> RobotStatus:
+        message = self._robot_state.wait_for_message(
+            timeout_s, lambda message: predicate(robot_status_from_message(message))
+        )
+        return robot_status_from_message(message)
+
+    def on_robot_status(self, listener: Callable[[RobotStatus], None]) -> None:
+        """Call `listener(status)` on every change of /robot_state (on the ROS thread)."""
+        self._robot_state.add_listener(lambda message: listener(robot_status_from_message(message)))
+
+    def on_nest_occupancies(self, listener: Callable[[tuple[NestOccupancy, ...]], None]) -> None:
+        """Call `listener(nests)` on every change of /station_states (on the ROS thread)."""
+        self._station_states.add_listener(lambda message: listener(nest_occupancies_from_message(message)))

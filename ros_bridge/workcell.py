@@ -1,0 +1,82 @@
+"""Plain-Python views of what the robot side reports, so layers above never touch ROS messages.
+
+These are immutable snapshots built from labware_interfaces messages (see `robot_link.py`);
+they hold SI units (m, rad) like the messages they come from.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class StationDescription:
+    """A station the robot serves: its name, number of nests and the POI to work from."""
+
+    name: str
+    sub_positions: int
+    poi: str
+
+
+@dataclass(frozen=True)
+class WorkcellDescription:
+    """Everything the robot can serve, as the world file describes it."""
+
+    stations: tuple[StationDescription, ...]
+    hotel_slots: int
+    pois: tuple[str, ...]
+    dock_poi: str
+
+    def station(self, name: str) -> StationDescription | None:
+        return next((station for station in self.stations if station.name == name), None)
+
+
+@dataclass(frozen=True)
+class HotelSlotContent:
+    index: int
+    labware_id: str
+    labware_type: str
+
+
+@dataclass(frozen=True)
+class RobotStatus:
+    """One /robot_state message: state word, where the base is, what the robot carries."""
+
+    state: str
+    detail: str
+    current_poi: str
+    x_m: float
+    y_m: float
+    theta_rad: float
+    hotel: tuple[HotelSlotContent, ...]
+    held_labware_id: str
+
+    @property
+    def docked(self) -> bool:
+        return self.state == "docked"
+
+    @property
+    def onboard_labware_ids(self) -> tuple[str, ...]:
+        held = (self.held_labware_id,) if self.held_labware_id else ()
+        return tuple(slot.labware_id for slot in self.hotel if slot.labware_id) + held
+
+
+@dataclass(frozen=True)
+class NestOccupancy:
+    """One nest of a station, as the station's sensor reports it."""
+
+    station: str
+    sub_position: int
+    occupied: bool
+    labware_id: str
+
+
+@dataclass(frozen=True)
+class PlacementCheck:
+    """Physics ground truth about one plate (for success checks only, never for control)."""
+
+    found: bool
+    in_nest: bool
+    position_error_m: float
+    yaw_error_rad: float
+    location: str

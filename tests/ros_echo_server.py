@@ -1,0 +1,125 @@
+"""A small real ROS 2 peer for the bridge tests, run as a separate process.
+
+Serves /navigate_to_poi (NavigateToPoi): drives a pretend base for `--goal-seconds`, sending
+feedback at 20 Hz; POI "nowhere" aborts with UNKNOWN_POI; cancel is honoured. Serves
+/describe_workcell with two stations. Publishes RobotState on /robot_state at 10 Hz, whose
+`detail` counts the goals finished so far. Prints "READY" once everything is created.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import threading
+import time
+
+import rclpy
+from labware_interfaces.action import NavigateToPoi
+from labware_interfaces.msg import ErrorCodes, RobotState, StationInfo
+from labware_interfaces.srv import DescribeWorkcell
+from rclpy.action import ActionServer, CancelResponse, GoalResponse
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.node import Node
+
+
+class EchoRobot(Node):
+    """Pretend robot: one action, one service, one state topic."""
+
+    def __init__(self, goal_seconds: float) -> None:
+        super().__init__("bridge_test_echo_robot")
+        self._goal_seconds = goal_seconds
+        self._finished_goals = 0
+        self._current_poi = ""
+        self._lock = threading.Lock()
+        group = ReentrantCallbackGroup()
+        self._action_server = ActionServer(
+            self,
+            NavigateToPoi,
+            "/navigate_to_poi",
+            execute_callback=self._execute,
+            goal_callback=lambda _goal: GoalResponse.ACCEPT,
+            cancel_callback=lambda _handle: CancelResponse.ACCEPT,
+            callback_group=group,
+        )
+        self._service = self.create_service(
+            DescribeWorkcell, "/describe_workcell", self._describe, callback_group=group
+        )
+        self._state_publisher = self.create_publisher(RobotState, "/robot_state", 1)
+        self._timer = self.create_timer(0.1, self._publish_state, callback_group=group)
+
+    def _describe(self, _request: DescribeWorkcell.Request, response: DescribeWorkcell.Response):
+        response.stations = [
+            StationInfo(name="reader", sub_positions=1, poi="reader_poi"),
+            StationInfo(name="rack", sub_positions=4, poi="rack_poi"),
+        ]
+        response.hotel_slots = 2
+        response.pois = ["reader_poi", "rack_poi", "dock_approach"]
+        response.dock_poi = "dock_approach"
+        return response
+
+    def _publish_state(self) -> None:
+        with self._lock:
+            message = RobotState(
+                state=RobotState.STATE_IDLE,
+                detail=f"finished {self._finished_goals}",
+                current_poi=self._current_poi,
+            )
+        message.stamp = self.get_clock().now().to_msg()
+        self._state_publisher.publish(message)
+
+    def _execute(self, goal_handle) -> NavigateToPoi.Result:
+        poi = goal_handle.request.poi
+        result = NavigateToPoi.Result()
+        if poi == "nowhere":
+            goal_handle.abort()
+            result.success, result.error_code = False, ErrorCodes.UNKNOWN_POI
+            result.message = f"no point of interest named {poi!r}"
+            return result
+        started = time.monotonic()
+        while True:
+            elapsed = time.monotonic() - started
+            if goal_handle.is_cancel_requested:
+                goal_handle.canceled()
+                result.success, result.error_code = False, ErrorCodes.CANCELED
+                result.message = f"cancelled after {elapsed:.2f} s"
+                return result
+            if elapsed >= self._goal_seconds:
+                break
+            feedback = NavigateToPoi.Feedback(
+                progress=elapsed / self._goal_seconds,
+                phase="driving",
+                remaining_time_s=self._goal_seconds - elapsed,
+            )
+            goal_handle.publish_feedback(feedback)
+            time.sleep(0.05)
+        goal_handle.succeed()
+        with self._lock:
+            self._finished_goals += 1
+            self._current_poi = poi
+        result.success, result.message = True, f"arrived at {poi}"
+        return result
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--goal-seconds", type=float, default=1.0)
+    args = parser.parse_args()
+    rclpy.init()
+    node = EchoRobot(args.goal_seconds)
+    executor = MultiThreadedExecutor(num_threads=4)
+    executor.add_node(node)
+    print("READY", flush=True)
+    try:
+        executor.spin()
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        executor.shutdown(timeout_sec=0.5)
+        node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
