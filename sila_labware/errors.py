@@ -1,0 +1,20 @@
+"""Errors of the robot logic, free of SiLA and ROS; the feature implementations translate them.
+
+`CommandSequenceError` becomes the standard's defined error InvalidCommandSequence;
+`ParameterError` becomes a SiLA validation error naming the parameter.
+"""
+
+from __future__ import annotations
+
+
+class CommandSequenceError(Exception):
+    """A command arrived in an order the labware transfer protocol does not allow."""
+
+
+class ParameterError(ValueError):
+    """A parameter value is outside what this device offers; `parameter` is its SiLA identifier."""
+
+    def __init__(self, parameter: str, message: str) -> None:
+        super().__init__(message)
+        self.parameter = parameter
+        self.message = message
