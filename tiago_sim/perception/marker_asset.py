@@ -35,12 +35,12 @@ DICTIONARY_SIZE = 50
 MARKER_CELLS = 6
 # White margin around the black square, in cells (one cell = size_m / 6).
 QUIET_ZONE_CELLS = 1
-# Texture resolution per cell; 32 px per cell gives a 256 px texture for 8 cells.
-PIXELS_PER_CELL = 32
+# Texture resolution per cell: 128 px per cell gives a 1024 px texture for 8 cells.
+PIXELS_PER_CELL = 128
 # Ids of DICT_4X4_50 whose mirror image still decodes as the same id: a marker seen from the
 # wrong side (or a mirrored texture) would be accepted, so these are refused.
 MIRROR_AMBIGUOUS_IDS = frozenset({8, 9, 17, 47})
-ASSET_VERSION = "v1"
+ASSET_VERSION = "v2"
 
 
 def default_cache_dir() -> Path:
