@@ -1,0 +1,165 @@
+"""MarkerMotion: move the tool to a nest located from the station's ArUco marker (robot software).
+
+Why this is robot software and not simulation: it uses only what a real TIAGo has - the head
+camera's pixels and depth, its joint readings and its kinematic model. The marker pose comes from
+perception.detect_marker on the rendered image; the camera pose in base_footprint from forward
+kinematics of the joint readings taken with the image; never from simulator link states.
+
+Steps: take an image (sim thread) -> detect the marker (this thread) -> T_base_marker =
+T_base_optical @ T_optical_marker -> the nest frame from the world's site_in_marker, sub-position
+spacing and approach height -> the grasp pose in that frame (fingers down, closing across the
+plate's short side; the flipped twin if IK prefers it) -> Simulation.move_tool. A sighting is
+reused while the base has not moved and no keyframe motion ran since, because the arm above the
+nest hides the marker from the head. Lives on: an rclpy executor thread (one goal at a time).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import threading
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from geometry_msgs.msg import Pose
+from labware_interfaces.msg import ErrorCodes
+
+from tiago_sim.action_run import ActionAbort, ActionRun
+from tiago_sim.kinematics import RobotKinematics
+from tiago_sim.motion_library import HotelGrasp
+from tiago_sim.perception.aruco import detect_marker
+from tiago_sim.robot_behaviours import RobotBehaviours
+from tiago_sim.transforms import make_transform, to_pose
+from tiago_sim.world import World
+
+log = logging.getLogger(__name__)
+
+TARGETS = ("site_approach", "site")
+CAMERA_FRAME = "head_camera_optical_frame"
+# A cached marker stays valid while odometry moved less than this.
+SAME_BASE_POSITION_M = 0.002
+SAME_BASE_YAW_RAD = 0.003
+# Half-turn about the grasp x axis: the same top-down grasp with the fingers swapped.
+FLIP_ABOUT_APPROACH = make_transform(rotation=np.diag([1.0, -1.0, -1.0]))
+
+
+@dataclass(frozen=True)
+class MarkerSighting:
+    station: str
+    T_base_marker: np.ndarray
+    odometry: tuple[float, float, float]
+    reprojection_error_px: float
+
+
+def pose_msg(transform: np.ndarray) -> Pose:
+    position, quat = to_pose(transform)
+    pose = Pose()
+    pose.position.x, pose.position.y, pose.position.z = (float(v) for v in position)
+    pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w = (float(v) for v in quat)
+    return pose
+
+
+class MarkerMotionBehaviour:
+    """Execute function of /marker_motion."""
+
+    def __init__(self, world: World, behaviours: RobotBehaviours, grasp: HotelGrasp) -> None:
+        self.world = world
+        self.behaviours = behaviours
+        self.grasp = grasp
+        self.kinematics = RobotKinematics()
+        self._lock = threading.Lock()
+        self.last_sighting: MarkerSighting | None = None
+
+    def forget(self) -> None:
+        """Drop the cached sighting (the head or base is about to move)."""
+        self.last_sighting = None
+
+    def look(self, run: ActionRun, station_name: str) -> MarkerSighting:
+        """Image + joints at one instant, marker detection, marker pose in base_footprint."""
+        station = self.world.station(station_name)
+
+        def capture(sim: Any) -> tuple:
+            rgb, depth, intrinsics = sim.render_head_camera()
+            return rgb, depth, intrinsics, dict(sim.joint_positions()), tuple(sim.odometry())
+
+        run.feedback(0.05, "looking", 0.0, force=True)
+        rgb, depth, intrinsics, joints, odometry = run.sim(capture)
+        observation = detect_marker(rgb, intrinsics, station.marker_id, station.marker_size, depth)
+        if observation is None:
+            raise ActionAbort(ErrorCodes.MARKER_NOT_FOUND, f"marker not found: {station.marker_id}")
+        with self._lock:
+            T_base_optical = self.kinematics.forward(joints, CAMERA_FRAME)
+        sighting = MarkerSighting(
+            station_name,
+            T_base_optical @ observation.T_optical_marker,
+            odometry,
+            observation.reprojection_error_px,
+        )
+        log.info(
+            "marker %d of %s at %s in base (reprojection %.2f px)",
+            station.marker_id, station_name, np.round(sighting.T_base_marker[:3, 3], 4),
+            observation.reprojection_error_px,
+        )  # fmt: skip
+        self.last_sighting = sighting
+        return sighting
+
+    def _cached(self, run: ActionRun, station_name: str) -> MarkerSighting | None:
+        sighting = self.last_sighting
+        if sighting is None or sighting.station != station_name:
+            return None
+        x, y, yaw = run.sim(lambda sim: tuple(sim.odometry()))
+        moved = math.hypot(x - sighting.odometry[0], y - sighting.odometry[1])
+        turned = abs(math.remainder(yaw - sighting.odometry[2], math.tau))
+        return sighting if moved < SAME_BASE_POSITION_M and turned < SAME_BASE_YAW_RAD else None
+
+    def grasp_target(self, arm: str, T_base_site: np.ndarray, seed: dict[str, float]) -> np.ndarray:
+        """Top-down grasp pose at the site; of the two finger orders, the one IK reaches nearest."""
+        T_base_grasp = T_base_site @ self.grasp.T_slot_grasp(approach=False)
+        candidates = [T_base_grasp, T_base_grasp @ FLIP_ABOUT_APPROACH]
+        best, best_distance = candidates[0], math.inf
+        for candidate in candidates:
+            targets = self.behaviours.solve_ik(arm, candidate, seed)
+            if targets is None:
+                continue
+            distance = sum(abs(value - seed.get(name, 0.0)) for name, value in targets.items())
+            if distance < best_distance:
+                best, best_distance = candidate, distance
+        return best
+
+    def __call__(self, run: ActionRun, goal: Any) -> dict:
+        arm = self.behaviours.arm_of(goal.arm)
+        try:
+            station = self.world.station(goal.station)
+        except KeyError:
+            names = ", ".join(s.name for s in self.world.stations)
+            raise ActionAbort(
+                ErrorCodes.UNKNOWN_STATION, f"unknown station {goal.station!r}: known are {names}"
+            ) from None
+        if goal.target not in TARGETS:
+            raise ActionAbort(
+                ErrorCodes.BAD_GOAL, f"unknown target {goal.target!r}: use {' or '.join(TARGETS)}"
+            )
+        sub_position = int(goal.sub_position)
+        if not 1 <= sub_position <= station.sub_positions:
+            raise ActionAbort(
+                ErrorCodes.BAD_GOAL,
+                f"station {station.name} has sub-positions 1..{station.sub_positions}, not {sub_position}",
+            )
+        sighting = self._cached(run, station.name)
+        if sighting is None:
+            sighting = self.look(run, station.name)
+        marker_in_base = pose_msg(sighting.T_base_marker)
+        T_marker_site = (
+            station.T_marker_site(sub_position)
+            if goal.target == "site"
+            else station.T_marker_site_approach(sub_position)
+        )
+        seed = run.sim(lambda sim: dict(sim.joint_positions()))
+        T_base_target = self.grasp_target(arm, sighting.T_base_marker @ T_marker_site, seed)
+        try:
+            run.run_motion(lambda sim: sim.move_tool(arm, T_base_target, True), span=(0.1, 1.0))
+        except ActionAbort as abort:
+            abort.extra = {"marker_in_base": marker_in_base}
+            raise
+        return {"marker_in_base": marker_in_base}

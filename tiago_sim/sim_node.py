@@ -1,0 +1,224 @@
+"""The simulated TIAGo++ as a ROS 2 node: the one process that owns PyBullet.
+
+    python -m tiago_sim.sim_node --world FILE [--seed N] [--realtime-factor-cap X]
+
+Threads: the sim thread (sim_thread.SimThread) owns the Simulation and steps it; a
+MultiThreadedExecutor spins the node on the main thread; action execute callbacks and timers only
+hand jobs to the sim thread and wait on futures. Offers the robot-level actions (ros_actions),
+the sensor topics (ros_publishers), /describe_workcell and /check_placement (ground truth, for
+success checks only).
+
+ROS parameters (changeable at runtime): ``pois.<name>`` = [x, y, yaw] (from the world YAML),
+``stations.<name>.approach_height_m``, ``speed_scale``, ``realtime_factor_cap`` (0 = none),
+``idle_realtime_factor``, and - for tests only, as fault injection - ``fault.occlude_marker``:
+a station name whose marker gets hidden behind a visual-only panel (empty: none).
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import logging
+import signal
+import sys
+from pathlib import Path
+from typing import Any
+
+import rclpy
+from labware_interfaces.msg import StationInfo
+from labware_interfaces.srv import CheckPlacement, DescribeWorkcell
+from rcl_interfaces.msg import SetParametersResult
+from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.signals import SignalHandlerOptions
+
+from tiago_sim.fault_injection import Occluders
+from tiago_sim.marker_motion import MarkerMotionBehaviour
+from tiago_sim.motion_library import DEFAULT_MOTIONS_FILE, load_motions
+from tiago_sim.robot_behaviours import RobotBehaviours
+from tiago_sim.ros_actions import RobotActionServers
+from tiago_sim.ros_publishers import StatePublishers
+from tiago_sim.sim_thread import SimThread
+from tiago_sim.world import DEFAULT_WORLD, World, load_world
+
+log = logging.getLogger("tiago_sim.sim_node")
+
+
+class SimNode:
+    """Wires the Simulation (on its thread) to ROS topics, services and actions."""
+
+    def __init__(self, node: Node, world: World, sim_thread: SimThread, motions_file: Path) -> None:
+        self.node = node
+        self.world = world
+        self.sim_thread = sim_thread
+        self.occluders = Occluders(world)
+        self._declare_parameters()
+        motions = load_motions(motions_file)
+        self.behaviours = RobotBehaviours(
+            poi_pose=self.poi_pose,
+            poi_names=lambda: sorted(self.current_pois()),
+            dock_poi=lambda: world.dock_poi,
+            hotel_slots=world.hotel_slots,
+            motions=motions,
+            speed_scale=lambda: float(node.get_parameter("speed_scale").value),
+        )
+        self.marker_motion = MarkerMotionBehaviour(world, self.behaviours, motions.hotel)
+        self.behaviours.on_keyframe_motion = self.marker_motion.forget
+        self.actions = RobotActionServers(
+            node,
+            sim_thread,
+            navigate=self.behaviours.navigate,
+            dock=self.behaviours.dock,
+            undock=self.behaviours.undock,
+            play_motion=self.behaviours.play_motion,
+            marker_motion=self.marker_motion,
+            gripper=self.behaviours.gripper,
+        )
+        self.publishers = StatePublishers(
+            node, sim_thread, pois=self.current_pois, activity=self.actions.activity.snapshot
+        )
+        node.create_service(DescribeWorkcell, "/describe_workcell", self._describe_workcell)
+        node.create_service(CheckPlacement, "/check_placement", self._check_placement)
+        node.add_on_set_parameters_callback(self._on_parameters)
+
+    # -- parameters ------------------------------------------------------------------------
+    def _declare_parameters(self) -> None:
+        for name, pose in self.world.pois.items():
+            self.node.declare_parameter(f"pois.{name}", [pose.x, pose.y, pose.yaw])
+        for station in self.world.stations:
+            self.node.declare_parameter(f"stations.{station.name}.approach_height_m", station.approach_height)
+        self.node.declare_parameter("speed_scale", 1.0)
+        self.node.declare_parameter("realtime_factor_cap", float(self.sim_thread.realtime_factor_cap or 0.0))
+        self.node.declare_parameter("idle_realtime_factor", float(self.sim_thread.idle_realtime_factor))
+        self.node.declare_parameter("fault.occlude_marker", "")
+
+    def _on_parameters(self, parameters: list[Parameter]) -> SetParametersResult:
+        for parameter in parameters:
+            name, value = parameter.name, parameter.value
+            if name.startswith("pois.") and (not isinstance(value, (list, tuple)) or len(value) != 3):
+                return SetParametersResult(successful=False, reason=f"{name} must be [x, y, yaw]")
+            if name == "speed_scale" and not 0.05 <= float(value) <= 2.0:
+                return SetParametersResult(successful=False, reason="speed_scale must be in 0.05 .. 2.0")
+            if (
+                name == "fault.occlude_marker"
+                and value
+                and value not in {s.name for s in self.world.stations}
+            ):
+                return SetParametersResult(successful=False, reason=f"unknown station {value!r}")
+        for parameter in parameters:
+            self._apply(parameter.name, parameter.value)
+        return SetParametersResult(successful=True)
+
+    def _apply(self, name: str, value: Any) -> None:
+        if name == "realtime_factor_cap":
+            self.sim_thread.realtime_factor_cap = float(value) if value and float(value) > 0 else None
+        elif name == "idle_realtime_factor":
+            self.sim_thread.idle_realtime_factor = float(value)
+        elif name == "fault.occlude_marker":
+            station = str(value)
+            self.sim_thread.call(lambda sim: self.occluders.set_occluded(sim, station))
+        elif name.startswith("stations.") and name.endswith(".approach_height_m"):
+            station_name = name[len("stations.") : -len(".approach_height_m")]
+            stations = tuple(
+                dataclasses.replace(s, approach_height=float(value)) if s.name == station_name else s
+                for s in self.world.stations
+            )
+            self.world = dataclasses.replace(self.world, stations=stations)
+            self.marker_motion.world = self.world
+
+    def current_pois(self) -> dict[str, tuple[float, float, float]]:
+        pois = {}
+        for name in self.world.pois:
+            value = self.node.get_parameter(f"pois.{name}").value
+            pois[name] = (float(value[0]), float(value[1]), float(value[2]))
+        return pois
+
+    def poi_pose(self, name: str) -> tuple[float, float, float] | None:
+        return self.current_pois().get(name)
+
+    # -- services -------------------------------------------------------------------------
+    def _describe_workcell(self, _request: Any, response: Any) -> Any:
+        response.stations = [
+            StationInfo(name=s.name, sub_positions=s.sub_positions, poi=s.poi) for s in self.world.stations
+        ]
+        response.hotel_slots = self.world.hotel_slots
+        response.pois = sorted(self.world.pois)
+        response.dock_poi = self.world.dock_poi
+        return response
+
+    def _check_placement(self, request: Any, response: Any) -> Any:
+        try:
+            check = self.sim_thread.run(
+                lambda sim: sim.check_placement(
+                    request.labware_id, request.station, int(request.sub_position)
+                )
+            )
+        except Exception as error:  # noqa: BLE001 - answer "unknown" rather than fail the call
+            log.warning("check_placement failed: %s", error)
+            response.found, response.location = False, "unknown"
+            return response
+        response.found = bool(check.found)
+        response.in_nest = bool(check.in_nest)
+        response.position_error_m = float(check.position_error_m)
+        response.yaw_error_rad = float(check.yaw_error_rad)
+        response.location = str(check.location)
+        return response
+
+
+def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(prog="python -m tiago_sim.sim_node", description=__doc__.split("\n")[0])
+    parser.add_argument("--world", type=Path, default=DEFAULT_WORLD, help="world YAML (default: %(default)s)")
+    parser.add_argument("--seed", type=int, default=None, help="seed for odometry noise and IK restarts")
+    parser.add_argument(
+        "--realtime-factor-cap",
+        type=float,
+        default=None,
+        help="at most this many times real time (default: none)",
+    )
+    parser.add_argument("--motions", type=Path, default=DEFAULT_MOTIONS_FILE, help="keyframe motions YAML")
+    parser.add_argument("--log-level", default="INFO")
+    return parser.parse_args(argv)
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parse_args(argv)
+    logging.basicConfig(level=args.log_level, format="%(asctime)s %(levelname)s %(name)s: %(message)s")
+    world = load_world(args.world)
+    from tiago_sim.simulation import Simulation  # heavy import (PyBullet), only in the process that owns it
+
+    sim_thread = SimThread(
+        lambda: Simulation(world, seed=args.seed), realtime_factor_cap=args.realtime_factor_cap
+    )
+    rclpy.init(args=None, signal_handler_options=SignalHandlerOptions.NO)
+    node = rclpy.create_node("tiago_sim")
+    executor = MultiThreadedExecutor(num_threads=8)
+    stopping = False
+
+    def request_stop(signum: int, _frame: Any) -> None:
+        nonlocal stopping
+        log.info("signal %d: shutting down", signum)
+        stopping = True
+
+    signal.signal(signal.SIGINT, request_stop)
+    signal.signal(signal.SIGTERM, request_stop)
+    try:
+        sim_thread.start()
+        SimNode(node, world, sim_thread, args.motions)
+        executor.add_node(node)
+        log.info("sim node ready: world %s, %d stations", world.source, len(world.stations))
+        while not stopping and rclpy.ok():
+            executor.spin_once(timeout_sec=0.1)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        sim_thread.stop()
+        executor.shutdown(timeout_sec=1.0)
+        node.destroy_node()
+        if rclpy.ok():
+            rclpy.shutdown()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,139 @@
+"""The one thread that owns PyBullet: steps the Simulation and runs jobs handed to it.
+
+PyBullet is not thread-safe, so every call into the Simulation happens on this thread. ROS
+callbacks (other threads) submit jobs with `call(fn)` and wait on the returned future. The
+thread steps as fast as it may while a Motion runs (optionally capped at a real-time factor)
+and throttles to `idle_realtime_factor` while idle, so an idle node does not burn a core.
+"""
+
+from __future__ import annotations
+
+import logging
+import queue
+import threading
+import time
+from collections.abc import Callable
+from concurrent.futures import Future
+from typing import Any, TypeVar
+
+log = logging.getLogger(__name__)
+
+T = TypeVar("T")
+
+# While busy, run queued jobs after at most this many steps so ROS callbacks stay responsive.
+_STEPS_BETWEEN_JOB_CHECKS = 24
+
+
+class SimThread:
+    """Owns a Simulation built by `factory` on its own thread (lives on: the sim thread)."""
+
+    def __init__(
+        self,
+        factory: Callable[[], Any],
+        *,
+        realtime_factor_cap: float | None = None,
+        idle_realtime_factor: float = 1.0,
+    ) -> None:
+        self._factory = factory
+        self._jobs: queue.SimpleQueue[tuple[Callable[[Any], Any], Future]] = queue.SimpleQueue()
+        self._stop = threading.Event()
+        self._ready: Future = Future()
+        self.realtime_factor_cap = realtime_factor_cap
+        self.idle_realtime_factor = idle_realtime_factor
+        self.sim_time = 0.0  # copy of sim.sim_time, readable from any thread
+        self.steps = 0
+        self._thread = threading.Thread(target=self._run, name="sim", daemon=True)
+
+    def start(self, timeout_s: float = 60.0) -> None:
+        """Start the thread and wait until the Simulation is built (raises its error if not)."""
+        self._thread.start()
+        self._ready.result(timeout=timeout_s)
+
+    @property
+    def stopped(self) -> bool:
+        return self._stop.is_set()
+
+    def stop(self, timeout_s: float = 5.0) -> None:
+        self._stop.set()
+        self._thread.join(timeout=timeout_s)
+
+    def call(self, job: Callable[[Any], T]) -> Future:
+        """Run `job(sim)` on the sim thread; the future holds its return value or exception."""
+        future: Future = Future()
+        if self._stop.is_set():
+            future.set_exception(RuntimeError("simulation stopped"))
+            return future
+        self._jobs.put((job, future))
+        return future
+
+    def run(self, job: Callable[[Any], T], timeout_s: float = 30.0) -> T:
+        """`call` and wait for the result."""
+        return self.call(job).result(timeout=timeout_s)
+
+    def _run_jobs(self, sim: Any) -> None:
+        while True:
+            try:
+                job, future = self._jobs.get_nowait()
+            except queue.Empty:
+                return
+            if not future.set_running_or_notify_cancel():
+                continue
+            try:
+                future.set_result(job(sim))
+            except BaseException as error:  # noqa: BLE001 - handed to the waiting thread
+                future.set_exception(error)
+
+    def _run(self) -> None:
+        try:
+            sim = self._factory()
+        except BaseException as error:  # noqa: BLE001 - reported to start()
+            log.exception("building the simulation failed")
+            self._ready.set_exception(error)
+            return
+        self._ready.set_result(True)
+        wall_start, sim_start = time.monotonic(), sim.sim_time
+        paced_factor: float | None = None
+        try:
+            while not self._stop.is_set():
+                self._run_jobs(sim)
+                if sim.busy():
+                    for _ in range(_STEPS_BETWEEN_JOB_CHECKS):
+                        sim.step()
+                        self.steps += 1
+                        if not sim.busy():
+                            break
+                    self.sim_time = sim.sim_time
+                    factor = self.realtime_factor_cap
+                else:
+                    sim.step()
+                    self.steps += 1
+                    self.sim_time = sim.sim_time
+                    factor = self.idle_realtime_factor
+                if factor is None or factor <= 0 or factor != paced_factor:
+                    # Unpaced, or the pace changed: measure from here.
+                    wall_start, sim_start = time.monotonic(), sim.sim_time
+                    paced_factor = factor
+                    continue
+                # Sleep until wall time catches up with sim time at the chosen factor.
+                ahead_s = (sim.sim_time - sim_start) / factor - (time.monotonic() - wall_start)
+                if ahead_s > 0:
+                    self._stop.wait(min(ahead_s, 0.05))
+                elif ahead_s < -0.5:  # fell behind (busy phases): do not try to catch up later
+                    wall_start, sim_start = time.monotonic(), sim.sim_time
+        finally:
+            self._drain_after_stop()
+            close = getattr(sim, "close", None)
+            if callable(close):
+                try:
+                    close()
+                except Exception:  # noqa: BLE001 - shutting down anyway
+                    log.debug("closing the simulation failed", exc_info=True)
+
+    def _drain_after_stop(self) -> None:
+        while True:
+            try:
+                _, future = self._jobs.get_nowait()
+            except queue.Empty:
+                return
+            if future.set_running_or_notify_cancel():
+                future.set_exception(RuntimeError("simulation stopped"))
