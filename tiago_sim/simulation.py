@@ -1,0 +1,356 @@
+"""The simulated TIAGo++ in its lab: the Simulation API the ROS node calls (see the module contract).
+
+Why one class: it owns the PyBullet client (DIRECT, fixed step) and is the only place where
+physics advances; motions are started by methods that return a Motion at once and run as step()
+is called. Sensors report what the robot could know (odometry, joint encoders, dock contact,
+gripper contact); ``check_placement`` is ground truth for success checks only.
+Lives on one thread (the sim thread): every method must be called there.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+import pybullet as p
+
+from tiago_sim import robot_model as rm
+from tiago_sim import transforms as tf
+from tiago_sim.arm_controller import JointTrajectoryMotion
+from tiago_sim.base_controller import DiffDriveBase, DriveMotion
+from tiago_sim.gripper_controller import Gripper, GripperMotion
+from tiago_sim.kinematics import RobotKinematics
+from tiago_sim.motion import BUSY, FailedMotion, Motion, SequenceMotion
+from tiago_sim.perception.camera import CameraIntrinsics, render_rgbd
+from tiago_sim.robot_body import RobotBody
+from tiago_sim.scene import build_scene, plate_bottom_pose
+from tiago_sim.world import World
+
+log = logging.getLogger(__name__)
+
+SOLVER_ITERATIONS = 150
+DOCK_SENSOR_RANGE = 0.004  # m: the charging contacts close within this distance
+DOCK_SPEED = 0.1
+TOOL_SPEED = 0.08  # m/s along straight tool moves
+STRAIGHT_STEP = 0.01  # m between IK waypoints
+MAX_WAYPOINT_JUMP = 0.25  # rad between consecutive IK waypoints
+NEST_SENSOR_RANGE = 0.02  # m: presence sensor sees a plate whose centre is this close to the site
+
+# Arms folded beside the torso (PAL's "home"), head level.
+HOME_ARM = (0.2, -1.34, -0.2, 1.94, -1.57, 1.37, 0.0)
+HOME_TORSO = 0.15
+
+
+@dataclass(frozen=True)
+class PlacementCheck:
+    """Ground truth about one plate (CheckPlacement service)."""
+
+    found: bool
+    in_nest: bool
+    position_error_m: float
+    yaw_error_rad: float
+    location: str
+
+
+class Simulation:
+    """PyBullet world + robot; see the module docstring for threading."""
+
+    def __init__(
+        self,
+        world: World,
+        *,
+        seed: int | None = None,
+        time_step: float = 1 / 240,
+        odometry_noise: float = 0.002,
+    ) -> None:
+        self.world = world
+        self.time_step = time_step
+        self.sim_time = 0.0
+        self.rng = np.random.default_rng(seed)
+        self.client_id = p.connect(p.DIRECT)
+        c = self.client_id
+        p.setGravity(0, 0, -9.81, physicsClientId=c)
+        p.setPhysicsEngineParameter(
+            fixedTimeStep=time_step, numSolverIterations=SOLVER_ITERATIONS, physicsClientId=c
+        )
+        self.robot = RobotBody(c, world.dock_pose.matrix())
+        self._reset_posture()
+        self.T_world_slot_at_start = {
+            i: self.robot.link_pose(f"hotel_slot_{i}") for i in range(1, world.hotel_slots + 1)
+        }
+        self.scene = build_scene(c, world, self.T_world_slot_at_start)
+        dock = world.dock_pose
+        self.base = DiffDriveBase(self.robot, dock.x, dock.y, dock.yaw, odometry_noise, self.rng)
+        self.grippers = {side: Gripper(self.robot, side, self.scene.plates) for side in rm.ARM_SIDES}
+        self.kinematics = RobotKinematics()
+        self.motions: list[Motion] = []
+        for _ in range(int(0.5 / time_step)):  # let plates settle in their nests
+            self.step()
+
+    def _reset_posture(self) -> None:
+        """Initial configuration (before any physics step): arms home, torso down a little."""
+        posture = {"torso_lift_joint": HOME_TORSO}
+        for side in rm.ARM_SIDES:
+            posture.update(dict(zip(rm.arm_joint_names(side), HOME_ARM, strict=True)))
+            posture.update({name: rm.FINGER_TRAVEL for name in rm.finger_joint_names(side)})
+        for name, value in posture.items():
+            p.resetJointState(
+                self.robot.id, self.robot.joint_index[name], value, physicsClientId=self.client_id
+            )
+        hold = {n: v for n, v in posture.items() if "finger" not in n}
+        hold.update({"head_1_joint": 0.0, "head_2_joint": 0.0})
+        self.robot.command_positions(hold)
+
+    def close(self) -> None:
+        if p.isConnected(self.client_id):
+            p.disconnect(self.client_id)
+
+    # ----------------------------------------------------------------- stepping
+    def step(self) -> None:
+        for motion in self.motions:
+            motion.advance(self.time_step)
+        self.base.update(self.time_step)
+        p.stepSimulation(physicsClientId=self.client_id)
+        self.base.integrate_odometry(self.time_step)
+        self.sim_time += self.time_step
+        self.motions = [m for m in self.motions if not m.done]
+
+    def busy(self) -> bool:
+        return any(not m.done for m in self.motions)
+
+    def run(self, motion: Motion, timeout_s: float = 120.0) -> Motion:
+        """Step until ``motion`` is done (helper for scripts and tests)."""
+        end = self.sim_time + timeout_s
+        while not motion.done and self.sim_time < end:
+            self.step()
+        if not motion.done:
+            motion.cancel()
+            for _ in range(int(2.0 / self.time_step)):
+                self.step()
+                if motion.done:
+                    break
+        return motion
+
+    def _start(self, motion: Motion) -> Motion:
+        if motion.done:
+            return motion
+        taken = set().union(*(m.resources for m in self.motions)) if self.motions else set()
+        if motion.resources & taken:
+            return FailedMotion(motion.name, BUSY, f"busy: {sorted(motion.resources & taken)}")
+        self.motions.append(motion)
+        return motion
+
+    # ----------------------------------------------------------------- sensors
+    def odometry(self) -> tuple[float, float, float]:
+        x, y, yaw = self.base.odom
+        return float(x), float(y), float(yaw)
+
+    def joint_positions(self) -> dict[str, float]:
+        return self.robot.joint_positions()
+
+    def is_docked(self) -> bool:
+        points = p.getClosestPoints(
+            self.robot.id, self.scene.dock, DOCK_SENSOR_RANGE, linkIndexA=-1, physicsClientId=self.client_id
+        )
+        return bool(points)
+
+    def render_head_camera(self, supersample: int = 1) -> tuple[np.ndarray, np.ndarray, CameraIntrinsics]:
+        intrinsics = CameraIntrinsics()
+        T_world_optical = self.robot.link_pose("head_camera_optical_frame")
+        rgb, depth = render_rgbd(self.client_id, T_world_optical, intrinsics, supersample=supersample)
+        return rgb, depth, intrinsics
+
+    def _plate_bottom(self, labware_id: str) -> np.ndarray:
+        body = self.scene.plates[labware_id]
+        return plate_bottom_pose(self.client_id, body, self.scene.plate_types[labware_id])
+
+    def _site_offset(self, T_world_site: np.ndarray, labware_id: str) -> np.ndarray:
+        return tf.invert(T_world_site) @ self._plate_bottom(labware_id)
+
+    def _plate_near(self, T_world_site: np.ndarray) -> str:
+        for labware_id in self.scene.plates:
+            offset = self._site_offset(T_world_site, labware_id)
+            if np.linalg.norm(offset[:2, 3]) < NEST_SENSOR_RANGE and abs(offset[2, 3]) < 0.01:
+                return labware_id
+        return ""
+
+    def nest_occupancy(self) -> list[tuple[str, int, bool, str]]:
+        result = []
+        for station in self.world.stations:
+            for sub in range(1, station.sub_positions + 1):
+                labware_id = self._plate_near(station.T_world_site(sub))
+                result.append((station.name, sub, bool(labware_id), labware_id))
+        return result
+
+    def hotel_occupancy(self) -> list[tuple[int, str, str]]:
+        result = []
+        for slot in range(1, self.world.hotel_slots + 1):
+            labware_id = self._plate_near(self.robot.link_pose(f"hotel_slot_{slot}"))
+            labware_type = self.scene.plate_types[labware_id].name if labware_id else ""
+            result.append((slot, labware_id, labware_type))
+        return result
+
+    def held_labware(self, arm: str) -> str:
+        return self.grippers[arm].touching()
+
+    # ----------------------------------------------------------------- motions
+    def drive_to(self, x: float, y: float, yaw: float, speed: float = rm.MAX_LINEAR_SPEED) -> Motion:
+        if self.is_docked():
+            return FailedMotion("drive", "DOCKED", "undock first")
+        return self._start(DriveMotion(self.base, x, y, yaw, speed=speed))
+
+    def dock(self) -> Motion:
+        if self.is_docked():
+            motion = FailedMotion("dock", "", "")
+            motion.success, motion.error_code, motion.message = True, "", "already docked"
+            return motion
+        approach = self.world.pois[self.world.dock_poi]
+        dock = self.world.dock_pose
+        stages = [
+            ("approach", lambda: DriveMotion(self.base, approach.x, approach.y, approach.yaw), 0.7),
+            (
+                "docking",
+                lambda: DriveMotion(
+                    self.base,
+                    dock.x,
+                    dock.y,
+                    dock.yaw,
+                    reverse=True,
+                    speed=DOCK_SPEED,
+                    stop_when=self.is_docked,
+                    name="dock_in",
+                ),
+                0.3,
+            ),
+        ]
+        return self._start(SequenceMotion("dock", stages, frozenset({"base"})))
+
+    def undock(self) -> Motion:
+        x, y, yaw = self.odometry()
+        distance = math.dist(
+            (self.world.dock_pose.x, self.world.dock_pose.y),
+            (self.world.pois[self.world.dock_poi].x, self.world.pois[self.world.dock_poi].y),
+        )
+        goal = (x + distance * math.cos(yaw), y + distance * math.sin(yaw), yaw)
+        motion = DriveMotion(self.base, *goal, speed=0.2, name="undock")
+        motion.phase = "driving"
+        return self._start(motion)
+
+    def move_joints(self, targets: dict[str, float], speed_scale: float = 1.0) -> Motion:
+        unknown = [n for n in targets if n not in self.robot.joint_index]
+        if unknown or not targets:
+            return FailedMotion(
+                "move_joints", "BAD_GOAL", f"unknown joints {unknown}" if unknown else "no targets"
+            )
+        resources = frozenset(self._joint_resource(n) for n in targets)
+        return self._start(
+            JointTrajectoryMotion(self.robot, [dict(targets)], speed_scale, resources=resources)
+        )
+
+    @staticmethod
+    def _joint_resource(name: str) -> str:
+        for side in rm.ARM_SIDES:
+            if name.startswith(f"arm_{side}_"):
+                return f"arm_{side}"
+            if name.startswith(f"gripper_{side}_"):
+                return f"gripper_{side}"
+        return name.split("_")[0]  # torso, head, wheel
+
+    def move_tool(self, arm: str, T_base_grasp: np.ndarray, straight_line: bool = True) -> Motion:
+        """Grasping frame of ``arm`` to a pose in base_footprint, via IK waypoints when straight."""
+        if arm not in rm.ARM_SIDES:
+            return FailedMotion("move_tool", "BAD_GOAL", f"unknown arm {arm!r}")
+        current = self.joint_positions()
+        T_start = self.kinematics.forward(current, f"arm_{arm}_grasping_frame")
+        T_goal = np.asarray(T_base_grasp, dtype=float)
+        waypoints = _straight_path(T_start, T_goal) if straight_line else [T_goal]
+        solutions: list[dict[str, float]] = []
+        seed = dict(current)
+        for index, T_waypoint in enumerate(waypoints):
+            restarts = 30 if (index == 0 and not straight_line) else 3
+            result = self.kinematics.inverse(
+                arm, T_waypoint, seed, use_torso=True, restarts=restarts, seed=int(self.rng.integers(1 << 30))
+            )
+            jump = max(
+                (abs(result.joint_positions[n] - seed[n]) for n in result.joint_positions), default=0.0
+            )
+            if not result.success or (straight_line and jump > MAX_WAYPOINT_JUMP):
+                why = "unreachable" if not result.success else f"joint jump {jump:.2f} rad"
+                return FailedMotion("move_tool", "IK_FAILED", f"waypoint {index + 1}/{len(waypoints)} {why}")
+            solutions.append(result.joint_positions)
+            seed.update(result.joint_positions)
+        segment_s = STRAIGHT_STEP / TOOL_SPEED if straight_line else 0.0
+        resources = frozenset({f"arm_{arm}", "torso"})
+        motion = JointTrajectoryMotion(
+            self.robot, solutions, 1.0, name="move_tool", min_segment_s=segment_s, resources=resources
+        )
+        return self._start(motion)
+
+    def gripper(self, arm: str, close: bool) -> Motion:
+        if arm not in rm.ARM_SIDES:
+            return FailedMotion("gripper", "BAD_GOAL", f"unknown arm {arm!r}")
+        return self._start(GripperMotion(self.grippers[arm], close))
+
+    # ----------------------------------------------------------------- ground truth
+    def check_placement(self, labware_id: str, station: str, sub_position: int) -> PlacementCheck:
+        if labware_id not in self.scene.plates:
+            return PlacementCheck(False, False, math.inf, math.inf, "unknown")
+        location = self._locate(labware_id)
+        if not station:
+            return PlacementCheck(True, False, math.nan, math.nan, location)
+        site = self.world.station(station)
+        offset = self._site_offset(site.T_world_site(sub_position), labware_id)
+        position_error = float(np.linalg.norm(offset[:2, 3]))
+        yaw_error = abs(tf.wrap_angle(tf.yaw_of(offset)))
+        tilt = tf.rotation_angle(np.eye(3), offset[:3, :3]) - yaw_error
+        margin = site.nest_clearance + 0.001
+        in_nest = bool(
+            abs(offset[0, 3]) <= margin
+            and abs(offset[1, 3]) <= margin
+            and abs(offset[2, 3]) < 0.002
+            and yaw_error < math.radians(2.0)
+            and abs(tilt) < math.radians(1.0)
+        )
+        return PlacementCheck(True, in_nest, position_error, float(yaw_error), location)
+
+    def _locate(self, labware_id: str) -> str:
+        for _side, gripper in self.grippers.items():
+            if gripper.attached_id == labware_id or gripper.touching() == labware_id:
+                return "gripper"
+        for name, sub, _, found in self.nest_occupancy():
+            if found == labware_id:
+                return f"station:{name}:{sub}"
+        for slot, found, _ in self.hotel_occupancy():
+            if found == labware_id:
+                return f"hotel:{slot}"
+        if self._plate_bottom(labware_id)[2, 3] < 0.05:
+            return "floor"
+        return "unknown"
+
+
+def _straight_path(T_start: np.ndarray, T_goal: np.ndarray) -> list[np.ndarray]:
+    """Poses along the straight line (and the shortest rotation) from start to goal, goal last."""
+    distance = float(np.linalg.norm(T_goal[:3, 3] - T_start[:3, 3]))
+    angle = tf.rotation_angle(T_start[:3, :3], T_goal[:3, :3])
+    count = max(1, math.ceil(distance / STRAIGHT_STEP), math.ceil(angle / 0.05))
+    relative = T_start[:3, :3].T @ T_goal[:3, :3]
+    axis_angle = _log_rotation(relative)
+    poses = []
+    for i in range(1, count + 1):
+        s = i / count
+        pose = np.eye(4)
+        pose[:3, 3] = T_start[:3, 3] + s * (T_goal[:3, 3] - T_start[:3, 3])
+        pose[:3, :3] = T_start[:3, :3] @ _exp_rotation(s * axis_angle)
+        poses.append(pose)
+    return poses
+
+
+def _log_rotation(rotation: np.ndarray) -> np.ndarray:
+    return np.asarray(pin.log3(rotation))
+
+
+def _exp_rotation(vector: np.ndarray) -> np.ndarray:
+    return np.asarray(pin.exp3(vector))
