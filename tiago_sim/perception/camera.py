@@ -122,3 +122,29 @@ def render_rgbd(
         rgb = cv2.resize(rgb, size, interpolation=cv2.INTER_AREA)
         depth_m = cv2.resize(depth_m, size, interpolation=cv2.INTER_AREA)
     return np.ascontiguousarray(rgb), depth_m
+
+
+def optical_frame_looking_at(
+    eye: np.ndarray, target: np.ndarray, roll: float = 0.0, up: tuple[float, float, float] = (0.0, 0.0, 1.0)
+) -> np.ndarray:
+    """T_world_optical of a camera at ``eye`` whose optical axis passes through ``target``.
+
+    With ``roll`` 0 the image is upright (optical y points as far down ``-up`` as it can);
+    ``roll`` turns the camera about its optical axis.
+    """
+    eye_point = np.asarray(eye, dtype=float)
+    z_axis = np.asarray(target, dtype=float) - eye_point
+    z_axis /= np.linalg.norm(z_axis)
+    up_axis = np.asarray(up, dtype=float)
+    x_axis = np.cross(-up_axis, z_axis)
+    if np.linalg.norm(x_axis) < 1e-9:
+        raise ValueError("the optical axis is parallel to 'up'; the camera roll is undefined")
+    x_axis /= np.linalg.norm(x_axis)
+    y_axis = np.cross(z_axis, x_axis)
+    cos_roll, sin_roll = np.cos(roll), np.sin(roll)
+    about_optical_axis = np.array([[cos_roll, -sin_roll, 0.0], [sin_roll, cos_roll, 0.0], [0.0, 0.0, 1.0]])
+    rotation = np.column_stack([x_axis, y_axis, z_axis]) @ about_optical_axis
+    transform = np.eye(4)
+    transform[:3, :3] = rotation
+    transform[:3, 3] = eye_point
+    return transform
