@@ -181,6 +181,17 @@ class RobotLink:
         )
         return robot_status_from_message(message)
 
+    def wait_for_nest(self, station: str, sub_position: int, occupied: bool, timeout_s: float = 5.0) -> None:
+        """Wait until the nest sensor of `station`/`sub_position` reports `occupied`."""
+
+        def matches(message: StationStates) -> bool:
+            return any(
+                nest.station == station and nest.sub_position == sub_position and nest.occupied == occupied
+                for nest in message.nests
+            )
+
+        self._station_states.wait_for_message(timeout_s, matches)
+
     def on_robot_status(self, listener: Callable[[RobotStatus], None]) -> None:
         """Call `listener(status)` on every change of /robot_state (on the ROS thread)."""
         self._robot_state.add_listener(lambda message: listener(robot_status_from_message(message)))

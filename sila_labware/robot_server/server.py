@@ -1,8 +1,17 @@
 # Created by sila2.code_generator 0.14.0 (new-package); hand-maintained since: regeneration never touches it.
+"""The robot's SiLA server: the standard manipulator feature plus our motion and inventory features.
+
+It is handed a `RobotController` (built on a running ROS bridge); the feature implementations
+take their behaviour from it.
+"""
+
+from __future__ import annotations
 
 from uuid import UUID, uuid4
 
 from sila2.server import SilaServer
+
+from sila_labware.robot_controller import RobotController
 
 from .feature_implementations.labwareinventory_impl import LabwareInventoryImpl
 from .feature_implementations.labwaretransfermanipulatorcontroller_impl import (
@@ -17,6 +26,7 @@ from .generated.mobilerobotcontroller import MobileRobotControllerFeature
 class Server(SilaServer):
     def __init__(
         self,
+        robot: RobotController,
         server_uuid: UUID | None = None,
         name: str | None = None,
         description: str | None = None,
@@ -36,6 +46,7 @@ class Server(SilaServer):
             server_vendor_url="https://github.com/sila-labware/sila-labware",
             server_uuid=server_uuid if server_uuid is not None else uuid4(),
         )
+        self.robot = robot
 
         self.labwareinventory = LabwareInventoryImpl(self)
         self.set_feature_implementation(LabwareInventoryFeature, self.labwareinventory)
