@@ -24,8 +24,9 @@ T_OPTICAL_GL = np.diag([1.0, -1.0, -1.0, 1.0])
 # Where a renderer samples pixel (0, 0), in window coordinates from the left and top edges.
 # OpenGL samples pixel centres (0.5, 0.5). PyBullet's TinyRenderer samples at integer window
 # coordinates counted from the bottom and then flips the rows, which is (0, 1) from the top;
-# measured with the edges of a large box at 40 sub-pixel positions. Using the right offset
-# removes a 0.5 px shift in x and y that would otherwise bias every marker pose.
+# measured with the edges of a large box at 40 sub-pixel positions. The EGL plugin
+# (ER_BULLET_HARDWARE_OPENGL, Mesa on CPU) follows the OpenGL rule, checked the same way.
+# Using the right offset removes a 0.5 px shift that would otherwise bias every marker pose.
 GL_SAMPLE_OFFSET = (0.5, 0.5)
 TINY_RENDERER_SAMPLE_OFFSET = (0.0, 1.0)
 
