@@ -7,8 +7,10 @@ Pose rules learnt the hard way (see the shared notes): OpenCV 5 has no
 ``estimatePoseSingleMarkers``, so the pose comes from ``solvePnP``; ``IPPE_SQUARE`` can return
 a wrong pose for a marker seen exactly fronto-parallel and rotated 180 deg, so every candidate
 (both IPPE solutions, SQPNP) is refined and scored by its reprojection error, and the best wins.
-With a depth image, a plane fitted to the marker's depth pixels fixes the distance (the weakest
-part of a small marker's PnP pose) and breaks the tie between near-equal candidate poses.
+Corners come from straight-edge fits (corner_refinement), not from the detector alone.
+With a depth image, a plane fitted to the marker's depth pixels is cut by the four corner rays
+and the pose is the rigid fit to those 3D corners: the plane fixes distance and tilt, where a
+small marker's PnP pose is weakest and where its two-fold (flip) ambiguity lives.
 
 Pure functions on arrays; safe on any thread.
 """
