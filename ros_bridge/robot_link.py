@@ -48,6 +48,7 @@ def robot_status_from_message(message: RobotState) -> RobotStatus:
             HotelSlotContent(int(slot.index), slot.labware_id, slot.labware_type) for slot in message.hotel
         ),
         held_labware_id=message.held_labware_id,
+        stamp_s=message.stamp.sec + message.stamp.nanosec * 1e-9,
     )
 
 

@@ -50,6 +50,8 @@ class RobotStatus:
     theta_rad: float
     hotel: tuple[HotelSlotContent, ...]
     held_labware_id: str
+    stamp_s: float = 0.0
+    """The message stamp in seconds: the robot side's clock (simulated time in simulation)."""
 
     @property
     def docked(self) -> bool:

@@ -1,0 +1,125 @@
+"""Child processes of `sila-labware serve`: the robot side's ROS nodes, started and stopped as a group.
+
+Each child runs in its own process group (new session), so stopping it also stops anything it
+started; stop sends SIGTERM to every group, waits, then SIGKILLs what is left. Every child gets
+the ROS environment of this deployment (domain id, localhost-only discovery).
+
+Threads: used from the thread that runs the deployment (the CLI's main thread).
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+logger = logging.getLogger(__name__)
+
+
+def ros_environment(domain_id: int, base: Mapping[str, str] | None = None) -> dict[str, str]:
+    """The environment for ROS processes of one deployment: its own domain, this machine only."""
+    environment = dict(os.environ if base is None else base)
+    environment["ROS_DOMAIN_ID"] = str(domain_id)
+    environment.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+    environment.setdefault("RMW_IMPLEMENTATION", "rmw_fastrtps_cpp")
+    environment.setdefault("PYTHONUNBUFFERED", "1")
+    return environment
+
+
+class ChildExited(RuntimeError):
+    """A child process ended while the deployment needed it."""
+
+
+@dataclass
+class Child:
+    name: str
+    popen: subprocess.Popen
+    log_path: Path | None
+
+    @property
+    def running(self) -> bool:
+        return self.popen.poll() is None
+
+    def log_tail(self, lines: int = 15) -> str:
+        if self.log_path is None or not self.log_path.exists():
+            return ""
+        return "\n".join(self.log_path.read_text(errors="replace").splitlines()[-lines:])
+
+
+class ProcessGroup:
+    """Children started together and stopped together."""
+
+    def __init__(self, environment: Mapping[str, str], log_dir: Path | None = None) -> None:
+        self._environment = dict(environment)
+        self._log_dir = log_dir
+        self.children: list[Child] = []
+
+    def start_python_module(self, name: str, module: str, arguments: Sequence[str]) -> Child:
+        """Run `python -m module arguments...` with this interpreter; output goes to a log file."""
+        argv = [sys.executable, "-m", module, *arguments]
+        log_path = None
+        output = subprocess.DEVNULL
+        if self._log_dir is not None:
+            self._log_dir.mkdir(parents=True, exist_ok=True)
+            log_path = self._log_dir / f"{name}.log"
+            output = log_path.open("wb")
+        popen = subprocess.Popen(
+            argv,
+            env=self._environment,
+            stdout=output,
+            stderr=subprocess.STDOUT,
+            stdin=subprocess.DEVNULL,
+            start_new_session=True,
+        )
+        if output is not subprocess.DEVNULL:
+            output.close()  # the child holds its own descriptor
+        child = Child(name, popen, log_path)
+        self.children.append(child)
+        logger.info("started %s (pid %d): %s", name, popen.pid, " ".join(argv))
+        return child
+
+    def check_running(self) -> None:
+        """Raise ChildExited naming the first child that ended (with the end of its log)."""
+        for child in self.children:
+            code = child.popen.poll()
+            if code is not None:
+                tail = child.log_tail()
+                raise ChildExited(
+                    f"{child.name} exited with code {code}"
+                    + (f"; last lines of its log:\n{tail}" if tail else "")
+                )
+
+    def stop(self, timeout_s: float = 3.0) -> None:
+        """SIGTERM every child's process group, wait up to `timeout_s`, then SIGKILL the rest."""
+        for child in self.children:
+            _signal_group(child, signal.SIGTERM)
+        deadline = time.monotonic() + timeout_s
+        for child in self.children:
+            try:
+                child.popen.wait(max(0.0, deadline - time.monotonic()))
+            except subprocess.TimeoutExpired:
+                logger.warning("%s did not stop on SIGTERM within %.1f s: killing it", child.name, timeout_s)
+                _signal_group(child, signal.SIGKILL)
+                child.popen.wait(2.0)
+        self.children.clear()
+
+    def __enter__(self) -> ProcessGroup:
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self.stop()
+
+
+def _signal_group(child: Child, signal_number: int) -> None:
+    if child.popen.poll() is not None:
+        return
+    try:
+        os.killpg(child.popen.pid, signal_number)  # the child leads its own group (new session)
+    except ProcessLookupError:
+        pass
