@@ -30,7 +30,7 @@ from sila_labware.robot_controller import RobotController
 from sila_labware.robot_server.server import Server as RobotServer
 from sila_labware.station_controller import StationController
 from sila_labware.station_server.server import Server as StationServer
-from sila_labware.tls import self_signed_credentials, write_ca_bundle
+from sila_labware.tls import CertificateAuthority
 
 logger = logging.getLogger(__name__)
 
@@ -137,27 +137,28 @@ class Deployment:
         planned: list[tuple[SilaServer, str, str]] = [(RobotServer(self.robot), "robot", "")]
         for station in self.workcell.stations:
             planned.append((StationServer(StationController(self.link, station)), "station", station.name))
-        certificates: list[bytes] = []
+        authority = None if self.options.insecure else CertificateAuthority()
         for offset, (server, role, station_name) in enumerate(planned):
             port = self.options.port_base + offset
-            if self.options.insecure:
+            if authority is None:
                 server.start_insecure(self.options.host, port, enable_discovery=self.options.discovery)
             else:
-                credentials = self_signed_credentials(server.server_uuid, self.options.host)
+                credentials = authority.issue_server_credentials(
+                    server.server_uuid, server.server_name, self.options.host
+                )
                 server.start(
                     self.options.host,
                     port,
                     private_key=credentials.private_key_pem,
                     cert_chain=credentials.certificate_pem,
                     enable_discovery=self.options.discovery,
-                    ca_for_discovery=credentials.certificate_pem,
+                    ca_for_discovery=authority.certificate_pem,
                 )
-                certificates.append(credentials.certificate_pem)
             self.servers.append(
                 ServedServer(server.server_name, role, station_name, self.options.host, port, server)
             )
-        if certificates:
-            self.ca_file = write_ca_bundle(self.options.ca_file, certificates)
+        if authority is not None:
+            self.ca_file = authority.write_certificate(self.options.ca_file)
 
     def robot_server(self) -> ServedServer:
         return next(served for served in self.servers if served.role == "robot")

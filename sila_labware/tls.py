@@ -1,23 +1,31 @@
-"""TLS for our SiLA servers: one self-signed certificate per server, one CA file for clients.
+"""TLS for our SiLA servers: one private CA per deployment, one certificate per server.
 
-SiLA 2 requires encrypted connections outside tests. Each server gets a certificate made by
-sila2's own generator (it carries the server UUID in the SiLA extension and the host's IPs);
-being self-signed, each certificate is its own CA. Clients trust the concatenation of them all,
-written to one PEM file (`write_ca_bundle`); gRPC accepts such a bundle as root certificates.
+SiLA 2 requires encrypted connections outside tests. sila2 can make a self-signed certificate
+per server, but those all carry the same subject name: a client given several of them as roots
+picks the wrong one by name and the handshake fails. So a deployment makes its own small CA
+(kept in memory only), signs one certificate per server with it (with the server UUID in the
+SiLA extension, OID 1.3.6.1.4.1.58583, and the host's address as subject alternative name),
+and writes only the CA certificate to a file for clients.
 """
 
 from __future__ import annotations
 
+import datetime
+import ipaddress
 import logging
-import os
-from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 from uuid import UUID
 
-from sila2.server.encryption import generate_self_signed_certificate
+from cryptography import x509
+from cryptography.hazmat.primitives import hashes, serialization
+from cryptography.hazmat.primitives.asymmetric import ec
+from cryptography.x509.oid import ExtendedKeyUsageOID, NameOID
 
 logger = logging.getLogger(__name__)
+
+SILA_SERVER_UUID_OID = x509.ObjectIdentifier("1.3.6.1.4.1.58583")
+VALIDITY = datetime.timedelta(days=365)
 
 
 @dataclass(frozen=True)
@@ -26,19 +34,102 @@ class ServerCredentials:
     certificate_pem: bytes
 
 
-def self_signed_credentials(server_uuid: UUID, host: str) -> ServerCredentials:
-    private_key, certificate = generate_self_signed_certificate(server_uuid, host)
-    return ServerCredentials(private_key, certificate)
-
-
-def write_ca_bundle(path: Path, certificates: Iterable[bytes]) -> Path:
-    """Write the servers' certificates as one PEM bundle (world-readable: it holds no secret)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    bundle = b"".join(
-        certificate if certificate.endswith(b"\n") else certificate + b"\n" for certificate in certificates
+def _name(common_name: str) -> x509.Name:
+    return x509.Name(
+        [
+            x509.NameAttribute(NameOID.ORGANIZATION_NAME, "sila-labware deployment"),
+            x509.NameAttribute(NameOID.COMMON_NAME, common_name),
+        ]
     )
-    path.write_bytes(bundle)
-    os.chmod(path, 0o644)
-    logger.info("wrote the CA bundle for clients to %s", path)
-    return path
+
+
+def _subject_alternative_names(host: str) -> list[x509.GeneralName]:
+    names: list[x509.GeneralName] = [
+        x509.DNSName("localhost"),
+        x509.IPAddress(ipaddress.ip_address("127.0.0.1")),
+    ]
+    try:
+        address = ipaddress.ip_address(host)
+    except ValueError:
+        names.append(x509.DNSName(host))
+    else:
+        if str(address) != "127.0.0.1" and not address.is_unspecified:
+            names.append(x509.IPAddress(address))
+    return names
+
+
+class CertificateAuthority:
+    """A throw-away CA: its key never leaves memory; its certificate is what clients trust."""
+
+    def __init__(self, common_name: str = "sila-labware CA") -> None:
+        self._key = ec.generate_private_key(ec.SECP256R1())
+        now = datetime.datetime.now(datetime.timezone.utc)
+        self._name = _name(common_name)
+        self.certificate = (
+            x509.CertificateBuilder()
+            .subject_name(self._name)
+            .issuer_name(self._name)
+            .public_key(self._key.public_key())
+            .serial_number(x509.random_serial_number())
+            .not_valid_before(now - datetime.timedelta(hours=1))
+            .not_valid_after(now + VALIDITY)
+            .add_extension(x509.BasicConstraints(ca=True, path_length=0), critical=True)
+            .add_extension(
+                x509.KeyUsage(
+                    digital_signature=False,
+                    content_commitment=False,
+                    key_encipherment=False,
+                    data_encipherment=False,
+                    key_agreement=False,
+                    key_cert_sign=True,
+                    crl_sign=True,
+                    encipher_only=False,
+                    decipher_only=False,
+                ),
+                critical=True,
+            )
+            .add_extension(x509.SubjectKeyIdentifier.from_public_key(self._key.public_key()), critical=False)
+            .sign(self._key, hashes.SHA256())
+        )
+
+    @property
+    def certificate_pem(self) -> bytes:
+        return self.certificate.public_bytes(serialization.Encoding.PEM)
+
+    def issue_server_credentials(self, server_uuid: UUID, server_name: str, host: str) -> ServerCredentials:
+        """Key and certificate for one SiLA server, signed by this CA."""
+        key = ec.generate_private_key(ec.SECP256R1())
+        now = datetime.datetime.now(datetime.timezone.utc)
+        certificate = (
+            x509.CertificateBuilder()
+            .subject_name(_name(server_name))
+            .issuer_name(self._name)
+            .public_key(key.public_key())
+            .serial_number(x509.random_serial_number())
+            .not_valid_before(now - datetime.timedelta(hours=1))
+            .not_valid_after(now + VALIDITY)
+            .add_extension(x509.BasicConstraints(ca=False, path_length=None), critical=True)
+            .add_extension(x509.ExtendedKeyUsage([ExtendedKeyUsageOID.SERVER_AUTH]), critical=False)
+            .add_extension(x509.SubjectAlternativeName(_subject_alternative_names(host)), critical=False)
+            .add_extension(
+                x509.UnrecognizedExtension(SILA_SERVER_UUID_OID, str(server_uuid).encode("ascii")),
+                critical=False,
+            )
+            .add_extension(
+                x509.AuthorityKeyIdentifier.from_issuer_public_key(self._key.public_key()), critical=False
+            )
+            .sign(self._key, hashes.SHA256())
+        )
+        key_pem = key.private_bytes(
+            serialization.Encoding.PEM, serialization.PrivateFormat.PKCS8, serialization.NoEncryption()
+        )
+        return ServerCredentials(key_pem, certificate.public_bytes(serialization.Encoding.PEM))
+
+    def write_certificate(self, path: Path) -> Path:
+        """Write the CA certificate for clients (world-readable: it holds no secret)."""
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_bytes(self.certificate_pem)
+        path.chmod(0o644)
+        logger.info("wrote the CA certificate for clients to %s", path)
+        return path
