@@ -45,6 +45,7 @@ class DiffDriveBase:
         self.v_cmd = 0.0
         self.w_cmd = 0.0
         self.odom = [x, y, yaw]
+        self.last_true = (x, y, yaw)
         self.noise = odometry_noise
         self.rng = rng
         # per-wheel radius errors (calibration), drawn once: the systematic part of odometry drift
@@ -71,23 +72,29 @@ class DiffDriveBase:
         self.body.set_base_target(*self.target)
 
     def integrate_odometry(self, dt: float) -> None:
-        """After the physics step: wheel encoders from the real base motion, with error, integrated."""
-        v, w = self.body.base_twist()
+        """After the physics step: wheel encoders count the base's real displacement, with error."""
+        pose = self.body.base_pose()
+        x, y, yaw = pose[0, 3], pose[1, 3], math.atan2(pose[1, 0], pose[0, 0])
+        last_x, last_y, last_yaw = self.last_true
+        self.last_true = (x, y, yaw)
+        heading = last_yaw + 0.5 * wrap_angle(yaw - last_yaw)
+        forward = (x - last_x) * math.cos(heading) + (y - last_y) * math.sin(heading)
+        turn = wrap_angle(yaw - last_yaw)
         half = rm.WHEEL_SEPARATION / 2
-        wheel_left = (v - w * half) / rm.WHEEL_RADIUS
-        wheel_right = (v + w * half) / rm.WHEEL_RADIUS
-        if self.noise > 0.0 and (abs(wheel_left) + abs(wheel_right)) > 1e-4:
+        wheel_left = forward - turn * half  # wheel travel in m this step
+        wheel_right = forward + turn * half
+        if self.noise > 0.0 and (abs(wheel_left) + abs(wheel_right)) > 1e-7:
             jitter_left, jitter_right = self.rng.standard_normal(2).tolist()
             wheel_left *= self.wheel_scale[0] * (1.0 + self.noise * jitter_left)
             wheel_right *= self.wheel_scale[1] * (1.0 + self.noise * jitter_right)
-        v_odom = rm.WHEEL_RADIUS * (wheel_left + wheel_right) / 2
-        w_odom = rm.WHEEL_RADIUS * (wheel_right - wheel_left) / rm.WHEEL_SEPARATION
-        x, y, yaw = self.odom
-        mid_yaw = yaw + 0.5 * w_odom * dt
+        distance = (wheel_left + wheel_right) / 2
+        rotation = (wheel_right - wheel_left) / rm.WHEEL_SEPARATION
+        ox, oy, oyaw = self.odom
+        mid_yaw = oyaw + 0.5 * rotation
         self.odom = [
-            x + v_odom * math.cos(mid_yaw) * dt,
-            y + v_odom * math.sin(mid_yaw) * dt,
-            wrap_angle(yaw + w_odom * dt),
+            ox + distance * math.cos(mid_yaw),
+            oy + distance * math.sin(mid_yaw),
+            wrap_angle(oyaw + rotation),
         ]
 
 
@@ -169,9 +176,14 @@ class DriveMotion(Motion):
             base.command(v, w)
         else:  # aligning
             error = wrap_angle(self.goal[2] - base.odom[2])
-            base.command(0.0, self._turn_rate(error))
-            if abs(error) < YAW_TOLERANCE * 0.5 and base.stopped():
+            within = abs(error) < YAW_TOLERANCE * 0.5
+            base.command(0.0, 0.0 if within else self._turn_rate(error))
+            if within and base.stopped():
                 if self.stop_when is not None:
                     self.finish(False, "NAVIGATION_FAILED", "reached the end of the path without contact")
                 else:
                     self.finish(True)
+
+    def finish(self, success: bool, error_code: str = "", message: str = "") -> None:
+        self.base.command(0.0, 0.0)
+        super().finish(success, error_code, message)

@@ -139,7 +139,8 @@ class GripperMotion(Motion):
         self.progress = float(min(0.99, 1.0 - remaining / rm.FINGER_TRAVEL))
         self.remaining_s = remaining / rm.FINGER_SPEED + 0.2
         speed = abs(gripper.body.joint_velocities(gripper.fingers)).max()
-        self.stall_s = self.stall_s + dt if speed < STALL_SPEED else 0.0
+        started = self.elapsed_s > 0.25  # fingers are at rest before they start to move
+        self.stall_s = self.stall_s + dt if (speed < STALL_SPEED and started) else 0.0
         if remaining < 5e-4 or self.stall_s > STALL_TIME_S:
             if self.close:
                 labware_id = gripper.touching()

@@ -109,7 +109,7 @@ def finger_joint_names(side: str) -> list[str]:
 
 
 def _fmt(values) -> str:
-    return " ".join(f"{float(v):.6g}" for v in values)
+    return " ".join(f"{float(v):.10g}" for v in values)
 
 
 def _rpy_aligning_z(direction: np.ndarray) -> tuple[float, float, float]:
@@ -174,7 +174,7 @@ class _UrdfWriter:
             text.append(f'<axis xyz="{_fmt(opts.get("axis", (0, 0, 1)))}"/>')
             lower, upper = opts.get("limits", (0.0, 0.0))
             text.append(
-                f'<limit lower="{lower:.6g}" upper="{upper:.6g}" '
+                f'<limit lower="{lower:.10g}" upper="{upper:.10g}" '
                 f'effort="{opts.get("effort", 10.0):.6g}" velocity="{opts.get("velocity", 1.0):.6g}"/>'
             )
             text.append('<dynamics damping="0.5" friction="0.0"/>')
