@@ -30,7 +30,7 @@ from tiago_sim.kinematics import RobotKinematics
 from tiago_sim.motion_library import HotelGrasp
 from tiago_sim.perception.aruco import detect_marker
 from tiago_sim.robot_behaviours import RobotBehaviours
-from tiago_sim.transforms import make_transform, to_pose
+from tiago_sim.transforms import to_pose
 from tiago_sim.world import World
 
 log = logging.getLogger(__name__)
@@ -40,8 +40,6 @@ CAMERA_FRAME = "head_camera_optical_frame"
 # A cached marker stays valid while odometry moved less than this.
 SAME_BASE_POSITION_M = 0.002
 SAME_BASE_YAW_RAD = 0.003
-# Half-turn about the grasp x axis: the same top-down grasp with the fingers swapped.
-FLIP_ABOUT_APPROACH = make_transform(rotation=np.diag([1.0, -1.0, -1.0]))
 
 
 @dataclass(frozen=True)
@@ -113,20 +111,6 @@ class MarkerMotionBehaviour:
         turned = abs(math.remainder(yaw - sighting.odometry[2], math.tau))
         return sighting if moved < SAME_BASE_POSITION_M and turned < SAME_BASE_YAW_RAD else None
 
-    def grasp_target(self, arm: str, T_base_site: np.ndarray, seed: dict[str, float]) -> np.ndarray:
-        """Top-down grasp pose at the site; of the two finger orders, the one IK reaches nearest."""
-        T_base_grasp = T_base_site @ self.grasp.T_slot_grasp(approach=False)
-        candidates = [T_base_grasp, T_base_grasp @ FLIP_ABOUT_APPROACH]
-        best, best_distance = candidates[0], math.inf
-        for candidate in candidates:
-            targets = self.behaviours.solve_ik(arm, candidate, seed)
-            if targets is None:
-                continue
-            distance = sum(abs(value - seed.get(name, 0.0)) for name, value in targets.items())
-            if distance < best_distance:
-                best, best_distance = candidate, distance
-        return best
-
     def __call__(self, run: ActionRun, goal: Any) -> dict:
         arm = self.behaviours.arm_of(goal.arm)
         try:
@@ -156,7 +140,8 @@ class MarkerMotionBehaviour:
             else station.T_marker_site_approach(sub_position)
         )
         seed = run.sim(lambda sim: dict(sim.joint_positions()))
-        T_base_target = self.grasp_target(arm, sighting.T_base_marker @ T_marker_site, seed)
+        T_base_grasp = sighting.T_base_marker @ T_marker_site @ self.grasp.T_slot_grasp(approach=False)
+        T_base_target = self.behaviours.grasp_twin(arm, T_base_grasp, seed)
         try:
             run.run_motion(lambda sim: sim.move_tool(arm, T_base_target, True), span=(0.1, 1.0))
         except ActionAbort as abort:

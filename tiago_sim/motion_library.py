@@ -32,6 +32,7 @@ class HotelGrasp:
 
     grasp_height_m: float  # grasping frame origin above the pocket floor when in "Nest"
     approach_height_m: float  # extra height above that for "NestApproach"
+    carry_height_m: float = 0.15  # tool rises this far above "NestApproach" to travel to/from the hotel
 
     def T_slot_grasp(self, approach: bool) -> np.ndarray:
         """Grasp pose in the slot frame: x (approach) down, y (closing) across the short side."""
@@ -90,6 +91,7 @@ def load_motions(path: Path = DEFAULT_MOTIONS_FILE) -> MotionLibrary:
         hotel=HotelGrasp(
             grasp_height_m=float(need(hotel, "grasp_height_m", "hotel.")),
             approach_height_m=float(need(hotel, "approach_height_m", "hotel.")),
+            carry_height_m=float(need(hotel, "carry_height_m", "hotel.")),
         ),
         speed_scale=float(document.get("speed_scale", 1.0)),
     )

@@ -15,14 +15,19 @@ import threading
 from collections.abc import Callable
 from typing import Any
 
+import numpy as np
 from labware_interfaces.msg import ErrorCodes
 
 from tiago_sim.action_run import ActionAbort, ActionRun
 from tiago_sim.kinematics import RobotKinematics
 from tiago_sim.motion_library import HOTEL_MOTIONS, MotionLibrary
 from tiago_sim.robot_model import ARM_SIDES
+from tiago_sim.transforms import make_transform
 
 log = logging.getLogger(__name__)
+
+# Half-turn about the grasp x axis: the same top-down grasp with the fingers swapped.
+FLIP_ABOUT_APPROACH = make_transform(rotation=np.diag([1.0, -1.0, -1.0]))
 
 
 class RobotBehaviours:
@@ -47,6 +52,8 @@ class RobotBehaviours:
         self.on_keyframe_motion: Callable[[], None] = lambda: None  # e.g. forget marker sightings
         self._kinematics = RobotKinematics()
         self._kinematics_lock = threading.Lock()
+        self.grasp_flipped: dict[str, bool] = {}  # per arm: twin of the top-down grasp last used
+        self.holding: dict[str, bool] = {}  # per arm: the last gripper command closed on a plate
 
     # -- checks ------------------------------------------------------------------------
     def arm_of(self, requested: str) -> str:
@@ -104,41 +111,103 @@ class RobotBehaviours:
             )
         self.on_keyframe_motion()
         frames = self.motions.frames_for(name, arm)
+        first = 0.0
+        if name != "Home":
+            first = self._leave_hotel(run, arm)  # never sweep a held plate through the hotel
         speed = self.speed_scale() * self.motions.speed_scale
         for index, targets in enumerate(frames):
-            span = (index / len(frames), (index + 1) / len(frames))
+            span = (
+                first + (1 - first) * index / len(frames),
+                first + (1 - first) * (index + 1) / len(frames),
+            )
             run.run_motion(lambda sim, targets=targets: sim.move_joints(targets, speed), span=span)
         return {}
 
     def solve_ik(
-        self, arm: str, T_base_grasp: Any, seed_positions: dict[str, float]
+        self, arm: str, T_base_grasp: Any, seed_positions: dict[str, float], *, use_torso: bool = True
     ) -> dict[str, float] | None:
         """Joint targets for the grasping frame at T_base_grasp, or None when unreachable."""
         with self._kinematics_lock:
-            result = self._kinematics.inverse(arm, T_base_grasp, seed_positions)
+            result = self._kinematics.inverse(
+                arm, T_base_grasp, seed_positions, use_torso=use_torso, restarts=60
+            )
         return dict(result.joint_positions) if result.success else None
 
-    def hotel_grasp_pose(self, slot: int, approach: bool) -> Any:
+    def tool_pose(self, arm: str, joint_positions: dict[str, float]) -> np.ndarray:
+        with self._kinematics_lock:
+            return self._kinematics.forward(joint_positions, f"arm_{arm}_grasping_frame")
+
+    def grasp_twin(self, arm: str, T_base_grasp: np.ndarray, seed: dict[str, float]) -> np.ndarray:
+        """A top-down grasp pose or its twin with the fingers swapped (half-turn about the approach).
+
+        With a plate in the gripper, the twin used when it was grasped, so the plate keeps its
+        orientation from nest to hotel and back; otherwise the first reachable in a fixed order.
+        """
+        twins = {False: T_base_grasp, True: T_base_grasp @ FLIP_ABOUT_APPROACH}
+        order = [self.grasp_flipped.get(arm, False)] if self.holding.get(arm) else [False, True]
+        for flip in order:
+            if self.solve_ik(arm, twins[flip], seed) is not None:
+                self.grasp_flipped[arm] = flip
+                return twins[flip]
+        raise ActionAbort(
+            ErrorCodes.IK_FAILED, f"the {arm} arm cannot reach {np.round(T_base_grasp[:3, 3], 3)}"
+        )
+
+    def hotel_grasp_pose(self, slot: int, approach: bool) -> np.ndarray:
         with self._kinematics_lock:
             T_base_slot = self._kinematics.forward({}, f"hotel_slot_{slot}")
         return T_base_slot @ self.motions.hotel.T_slot_grasp(approach)
 
+    def _tool_move(
+        self,
+        run: ActionRun,
+        arm: str,
+        T_base_grasp: np.ndarray,
+        span: tuple[float, float],
+        *,
+        free: bool = False,
+    ) -> None:
+        """Straight tool move to a top-down grasp pose; with `free`, a joint-space move when no
+        straight line exists (e.g. from the folded Home pose, where nothing is in the way)."""
+        seed = run.sim(lambda sim: dict(sim.joint_positions()))
+        target = self.grasp_twin(arm, T_base_grasp, seed)
+        try:
+            run.run_motion(lambda sim: sim.move_tool(arm, target, True), span=span)
+        except ActionAbort as abort:
+            if not free or abort.code != ErrorCodes.IK_FAILED:
+                raise
+            log.info("no straight path to %s: moving in joint space", np.round(target[:3, 3], 3))
+            run.run_motion(lambda sim: sim.move_tool(arm, target, False), span=span)
+
+    def _over_slot(self, arm: str, joints: dict[str, float], slot: int, radius_m: float) -> bool:
+        tool = self.tool_pose(arm, joints)[:3, 3]
+        return float(np.hypot(*(tool[:2] - self.hotel_grasp_pose(slot, True)[:2, 3]))) < radius_m
+
+    def _leave_hotel(self, run: ActionRun, arm: str) -> float:
+        """If the tool is over a hotel slot, rise straight to the carry height; returns progress used."""
+        joints = run.sim(lambda sim: dict(sim.joint_positions()))
+        for slot in range(1, self.hotel_slots + 1):
+            if self._over_slot(arm, joints, slot, 0.05):
+                T_carry = self.tool_pose(arm, joints)
+                T_carry[2, 3] = self.hotel_grasp_pose(slot, True)[2, 3] + self.motions.hotel.carry_height_m
+                run.run_motion(lambda sim, target=T_carry: sim.move_tool(arm, target, True), span=(0.0, 0.3))
+                return 0.3
+        return 0.0
+
     def _hotel_motion(self, run: ActionRun, arm: str, name: str, slot: int) -> None:
-        if name == "NestApproach":
-            # Joint-space move (from wherever the arm is) to the pose above the pocket.
-            T_base_grasp = self.hotel_grasp_pose(slot, approach=True)
-            seed = run.sim(lambda sim: sim.joint_positions())
-            targets = self.solve_ik(arm, T_base_grasp, seed)
-            if targets is None:
-                raise ActionAbort(
-                    ErrorCodes.IK_FAILED, f"no arm pose above hotel slot {slot} for the {arm} arm"
-                )
-            speed = self.speed_scale() * self.motions.speed_scale
-            run.run_motion(lambda sim: sim.move_joints(targets, speed))
+        T_approach = self.hotel_grasp_pose(slot, approach=True)
+        if name == "Nest":  # straight down into the pocket (back up: NestApproach)
+            self._tool_move(run, arm, self.hotel_grasp_pose(slot, approach=False), (0.0, 1.0))
             return
-        # "Nest": straight down into the pocket (and back up by playing NestApproach again).
-        T_base_grasp = self.hotel_grasp_pose(slot, approach=False)
-        run.run_motion(lambda sim: sim.move_tool(arm, T_base_grasp, True))
+        joints = run.sim(lambda sim: dict(sim.joint_positions()))
+        if self._over_slot(arm, joints, slot, 0.03):  # straight up or down to the approach pose
+            self._tool_move(run, arm, T_approach, (0.0, 1.0))
+            return
+        # From elsewhere: straight to the carry height above the slot, then straight down.
+        T_carry = T_approach.copy()
+        T_carry[2, 3] += self.motions.hotel.carry_height_m
+        self._tool_move(run, arm, T_carry, (0.0, 0.7), free=True)
+        self._tool_move(run, arm, T_approach, (0.7, 1.0))
 
     # -- gripper ------------------------------------------------------------------------
     def gripper(self, run: ActionRun, goal: Any) -> dict:
@@ -148,6 +217,8 @@ class RobotBehaviours:
                 ErrorCodes.BAD_GOAL, f"unknown gripper command {goal.command!r}: use open or close"
             )
         close = goal.command == "close"
+        self.holding[arm] = False if not close else self.holding.get(arm, False)
         motion = run.run_motion(lambda sim: sim.gripper(arm, close))
-        opening = float(getattr(motion, "opening_m", math.nan))
-        return {"holding": bool(getattr(motion, "holding", False)), "opening_m": opening}
+        holding = bool(getattr(motion, "holding", False))
+        self.holding[arm] = close and holding
+        return {"holding": holding, "opening_m": float(getattr(motion, "opening_m", math.nan))}

@@ -1,0 +1,150 @@
+"""The sub-action plans of GetLabware and PutLabware, and the checks before a plan starts.
+
+Pure data: a plan is a list of Steps (which action, which goal fields, an estimated duration),
+built from the goal and what the robot and stations report. The sequencer node runs it.
+Safe on any thread.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from labware_interfaces.msg import ErrorCodes, RobotState
+
+
+class TaskRefused(Exception):
+    """The goal cannot be done; nothing has moved yet."""
+
+    def __init__(self, code: str, message: str) -> None:
+        super().__init__(f"{code}: {message}")
+        self.code = code
+        self.message = message
+
+
+@dataclass(frozen=True)
+class Step:
+    action: str  # undock, navigate, play_motion, gripper, marker_motion
+    goal: dict[str, Any] = field(default_factory=dict)
+    phase: str = ""
+    expect_holding: bool | None = None  # gripper close: True means "must hold a plate"
+
+    def describe(self) -> str:
+        details = " ".join(f"{k}={v}" for k, v in self.goal.items() if k != "arm")
+        return f"{self.action} {details}".strip()
+
+
+@dataclass(frozen=True)
+class Workcell:
+    """What /describe_workcell reported."""
+
+    stations: dict[str, tuple[int, str]]  # name -> (sub_positions, poi)
+    hotel_slots: int
+
+
+def check_common(goal: Any, workcell: Workcell) -> tuple[int, str]:
+    """Station, sub-position and hotel slot exist; returns (sub_positions, poi)."""
+    if goal.handover_position not in workcell.stations:
+        known = ", ".join(sorted(workcell.stations))
+        raise TaskRefused(
+            ErrorCodes.UNKNOWN_STATION, f"unknown station {goal.handover_position!r}: known are {known}"
+        )
+    sub_positions, poi = workcell.stations[goal.handover_position]
+    if not 1 <= goal.sub_position <= sub_positions:
+        raise TaskRefused(
+            ErrorCodes.UNKNOWN_SLOT,
+            f"station {goal.handover_position} has sub-positions 1..{sub_positions}, not {goal.sub_position}",
+        )
+    if not 1 <= goal.internal_position <= workcell.hotel_slots:
+        raise TaskRefused(
+            ErrorCodes.UNKNOWN_SLOT,
+            f"unknown hotel slot {goal.internal_position}: the robot has 1..{workcell.hotel_slots}",
+        )
+    return sub_positions, poi
+
+
+def nest_state(station_states: Any, station: str, sub_position: int) -> Any | None:
+    for nest in station_states.nests:
+        if nest.station == station and nest.sub_position == sub_position:
+            return nest
+    return None
+
+
+def hotel_slot(robot_state: Any, index: int) -> Any | None:
+    for slot in robot_state.hotel:
+        if slot.index == index:
+            return slot
+    return None
+
+
+def travel_steps(robot_state: Any, poi: str) -> list[Step]:
+    """Arm home, off the dock, drive to the station's POI - whatever of it is needed."""
+    if robot_state.current_poi == poi and robot_state.state != RobotState.STATE_DOCKED:
+        return []
+    steps = [Step("play_motion", {"motion_name": "Home"}, "arm home")]
+    if robot_state.state == RobotState.STATE_DOCKED:
+        steps.append(Step("undock", {}, "undocking"))
+    steps.append(Step("navigate", {"poi": poi}, "driving"))
+    return steps
+
+
+def get_plan(goal: Any, workcell: Workcell, robot_state: Any, station_states: Any, arm: str) -> list[Step]:
+    """Checks, then the steps that take a plate from a station nest into a hotel slot."""
+    _, poi = check_common(goal, workcell)
+    slot = hotel_slot(robot_state, goal.internal_position)
+    if slot is not None and slot.labware_id:
+        raise TaskRefused(
+            ErrorCodes.SLOT_OCCUPIED, f"hotel slot {goal.internal_position} already holds {slot.labware_id}"
+        )
+    nest = nest_state(station_states, goal.handover_position, goal.sub_position)
+    if nest is None or not nest.occupied:
+        raise TaskRefused(
+            ErrorCodes.GRASP_FAILED, f"no plate at source {goal.handover_position}:{goal.sub_position}"
+        )
+    site = {"station": goal.handover_position, "sub_position": goal.sub_position, "arm": arm}
+    hotel = {"hotel_slot": goal.internal_position, "arm": arm}
+    return [
+        *travel_steps(robot_state, poi),
+        Step("play_motion", {"motion_name": "Benchtop", "arm": arm}, "arm to bench"),
+        Step("gripper", {"command": "open", "arm": arm}, "opening"),
+        Step("marker_motion", {**site, "target": "site_approach"}, "approach"),
+        Step("marker_motion", {**site, "target": "site"}, "reaching"),
+        Step("gripper", {"command": "close", "arm": arm}, "grasp", expect_holding=True),
+        Step("marker_motion", {**site, "target": "site_approach"}, "lifting"),
+        Step("play_motion", {"motion_name": "NestApproach", **hotel}, "to hotel"),
+        Step("play_motion", {"motion_name": "Nest", **hotel}, "into hotel"),
+        Step("gripper", {"command": "open", "arm": arm}, "release"),
+        Step("play_motion", {"motion_name": "NestApproach", **hotel}, "retract"),
+        Step("play_motion", {"motion_name": "Home", "arm": arm}, "arm home"),
+    ]
+
+
+def put_plan(goal: Any, workcell: Workcell, robot_state: Any, station_states: Any, arm: str) -> list[Step]:
+    """Checks, then the steps that take a plate from a hotel slot into a station nest."""
+    _, poi = check_common(goal, workcell)
+    nest = nest_state(station_states, goal.handover_position, goal.sub_position)
+    if nest is not None and nest.occupied:
+        holder = f" (holds {nest.labware_id})" if nest.labware_id else ""
+        raise TaskRefused(
+            ErrorCodes.NEST_OCCUPIED,
+            f"destination {goal.handover_position}:{goal.sub_position} is occupied{holder}",
+        )
+    slot = hotel_slot(robot_state, goal.internal_position)
+    if slot is None or not slot.labware_id:
+        raise TaskRefused(ErrorCodes.SLOT_EMPTY, f"hotel slot {goal.internal_position} holds no plate")
+    site = {"station": goal.handover_position, "sub_position": goal.sub_position, "arm": arm}
+    hotel = {"hotel_slot": goal.internal_position, "arm": arm}
+    return [
+        *travel_steps(robot_state, poi),
+        Step("gripper", {"command": "open", "arm": arm}, "opening"),
+        Step("play_motion", {"motion_name": "NestApproach", **hotel}, "to hotel"),
+        Step("play_motion", {"motion_name": "Nest", **hotel}, "into hotel"),
+        Step("gripper", {"command": "close", "arm": arm}, "grasp", expect_holding=True),
+        Step("play_motion", {"motion_name": "NestApproach", **hotel}, "lifting"),
+        Step("play_motion", {"motion_name": "Benchtop", "arm": arm}, "arm to bench"),
+        Step("marker_motion", {**site, "target": "site_approach"}, "approach"),
+        Step("marker_motion", {**site, "target": "site"}, "placing"),
+        Step("gripper", {"command": "open", "arm": arm}, "release"),
+        Step("marker_motion", {**site, "target": "site_approach"}, "retract"),
+        Step("play_motion", {"motion_name": "Home", "arm": arm}, "arm home"),
+    ]
