@@ -137,6 +137,8 @@ def _print_servers(deployment, stream) -> None:
         stream.write(f"{served.role:8} {served.name:32} {served.host}:{served.port}\n")
     if deployment.ca_file is not None:
         stream.write(f"CA file for clients: {deployment.ca_file.resolve()}\n")
+    for child in deployment.children.children:
+        stream.write(f"robot side: {child.name} pid {child.popen.pid}\n")
     stream.write(f"ROS domain: {deployment.domain_id}\n")
     stream.flush()
 
