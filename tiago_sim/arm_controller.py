@@ -81,9 +81,7 @@ class JointTrajectoryMotion(Motion):
             return
         t = self.elapsed_s
         position, velocity = self._sample(t)
-        self.body.command_positions(
-            dict(zip(self.names, position, strict=True)), dict(zip(self.names, velocity, strict=True))
-        )
+        self.body.track(self.names, position, velocity)
         self.progress = float(min(t / self.duration, 1.0)) * 0.99
         self.remaining_s = max(self.duration - t, 0.0)
         if t < self.duration:

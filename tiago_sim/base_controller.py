@@ -46,6 +46,7 @@ class DiffDriveBase:
         self.w_cmd = 0.0
         self.odom = [x, y, yaw]
         self.last_true = (x, y, yaw)
+        self.idle_steps = 0
         self.noise = odometry_noise
         self.rng = rng
         # per-wheel radius errors (calibration), drawn once: the systematic part of odometry drift
@@ -69,10 +70,15 @@ class DiffDriveBase:
             y + self.v * math.sin(mid_yaw) * dt,
             yaw + self.w * dt,
         ]
-        self.body.set_base_target(*self.target)
+        if self.v != 0.0 or self.w != 0.0:
+            self.body.set_base_target(*self.target)
 
     def integrate_odometry(self, dt: float) -> None:
         """After the physics step: wheel encoders count the base's real displacement, with error."""
+        moving = self.v != 0.0 or self.w != 0.0 or self.v_cmd != 0.0 or self.w_cmd != 0.0
+        self.idle_steps = 0 if moving else self.idle_steps + 1
+        if self.idle_steps > 240:  # stood still for a second: the encoders read nothing, skip the work
+            return
         pose = self.body.base_pose()
         x, y, yaw = pose[0, 3], pose[1, 3], math.atan2(pose[1, 0], pose[0, 0])
         last_x, last_y, last_yaw = self.last_true

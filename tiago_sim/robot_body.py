@@ -116,7 +116,7 @@ class RobotBody:
         """Position-control the named joints within their URDF effort and velocity limits."""
         for name, target in targets.items():
             lower, upper, velocity_limit, effort = self.limits[name]
-            target = float(np.clip(target, lower, upper)) if upper > lower else float(target)
+            target = min(max(float(target), lower), upper) if upper > lower else float(target)
             self.targets[name] = target
             p.setJointMotorControl2(
                 self.id,
@@ -130,6 +130,25 @@ class RobotBody:
                 velocityGain=1.0,
                 physicsClientId=self.client,
             )
+
+    def track(self, names: list[str], positions: np.ndarray, velocities: np.ndarray) -> None:
+        """Per-step trajectory tracking in one call (targets already timed within the velocity limits)."""
+        indices = [self.joint_index[n] for n in names]
+        lows = np.array([self.limits[n][0] for n in names])
+        highs = np.array([self.limits[n][1] for n in names])
+        clipped = np.where(highs > lows, np.clip(positions, lows, highs), positions)
+        self.targets.update(zip(names, clipped.tolist(), strict=True))
+        p.setJointMotorControlArray(
+            self.id,
+            indices,
+            p.POSITION_CONTROL,
+            targetPositions=clipped.tolist(),
+            targetVelocities=np.asarray(velocities, dtype=float).tolist(),
+            forces=[self.limits[n][3] for n in names],
+            positionGains=[ARM_POSITION_GAIN] * len(names),
+            velocityGains=[1.0] * len(names),
+            physicsClientId=self.client,
+        )
 
     def link_pose(self, link: str) -> np.ndarray:
         """Ground-truth T_world_link of a link frame (for rendering and checks, not for robot software)."""

@@ -340,6 +340,8 @@ def _read_plates(r: _Reader, data: dict, stations: dict[str, Station], types: di
             plate = InitialPlate(r.text(item, "id", where), labware_type, station, sub)
         if place in used:
             raise r.fail(where, f"{place} already holds a plate")
+        if any(known.labware_id == plate.labware_id for known in plates):
+            raise r.fail(f"{where}.id", f"duplicate plate id {plate.labware_id!r}")
         used.add(place)
         plates.append(plate)
     return tuple(plates)
