@@ -225,3 +225,24 @@ def test_motion_commands_map_robot_side_errors(robot: SilaClient) -> None:
     )
     finish(lambda: motion.Dock())  # already docked: succeeds at once
     assert motion.RobotState.get() == "Docked"
+
+
+def test_stop_motion_cancels_a_drive_through_the_whole_stack(robot: SilaClient) -> None:
+    """Runs last in this module: it leaves the robot undocked."""
+    motion = robot.MobileRobotController
+    finish(lambda: motion.Undock())
+    assert motion.RobotState.get() == "Idle"
+    drive = motion.DriveToPointOfInterest(PointOfInterest="lab_centre")
+    deadline = time.monotonic() + 30.0
+    while not (drive.progress or 0.0) > 0.0:
+        assert time.monotonic() < deadline and not drive.done, "the drive never reported progress"
+        time.sleep(0.05)
+    assert drive.estimated_remaining_time is not None and drive.estimated_remaining_time.total_seconds() > 0
+    motion.StopMotion()
+    while not drive.done:
+        assert time.monotonic() < deadline, "the drive did not end after StopMotion"
+        time.sleep(0.05)
+    with pytest.raises(DefinedExecutionError) as caught:
+        drive.get_responses()
+    assert caught.value.identifier == "MotionStopped"
+    assert motion.CurrentPointOfInterest.get() != "lab_centre"
