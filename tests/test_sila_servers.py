@@ -8,10 +8,13 @@ from collections.abc import Callable, Iterator
 from typing import Any
 
 import pytest
+from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
+from rcl_interfaces.srv import SetParameters
 from sila2.client import SilaClient
 from sila2.framework import DefinedExecutionError, ValidationError
 from sila_stack import client_for, start_stack
 
+from ros_bridge.services import ServiceCaller
 from sila_labware.deployment import Deployment
 
 MANIPULATOR = "org.silastandard/instruments.labware.manipulation/LabwareTransferManipulatorController/v1"
@@ -225,6 +228,45 @@ def test_motion_commands_map_robot_side_errors(robot: SilaClient) -> None:
     )
     finish(lambda: motion.Dock())  # already docked: succeeds at once
     assert motion.RobotState.get() == "Docked"
+
+
+def occlude_marker(stack: Deployment, station: str) -> None:
+    """Fault injection the sim node offers for tests: hide a station's marker from the camera."""
+    set_parameters = ServiceCaller(stack.runtime, SetParameters, "/tiago_sim/set_parameters")
+    set_parameters.wait_for_service(10.0)
+    value = ParameterValue(type=ParameterType.PARAMETER_STRING, string_value=station)
+    request = SetParameters.Request(parameters=[Parameter(name="fault.occlude_marker", value=value)])
+    assert all(result.successful for result in set_parameters.call(request, 10.0).results)
+
+
+def test_failed_get_is_labware_not_picked_and_inventory_stays_true(
+    stack: Deployment, robot: SilaClient, station_a: SilaClient
+) -> None:
+    """station_a/1 was left prepared for output by the command-order test; the plate is there."""
+    manipulator = robot.LabwareTransferManipulatorController
+    where = ("station_a", 1)
+    occlude_marker(stack, "station_a")
+    try:
+        finish(
+            lambda: manipulator.PrepareForInput(
+                HandoverPosition=where, InternalPosition=1, LabwareType="", LabwareUniqueID="plate_001"
+            )
+        )
+        assert robot.MobileRobotController.CurrentPointOfInterest.get() == "station_a_work"
+        with pytest.raises(DefinedExecutionError) as caught:
+            finish(lambda: manipulator.GetLabware(HandoverPosition=where, IntermediateActions=[]))
+        assert caught.value.identifier == "LabwareNotPicked"
+        assert "MARKER_NOT_FOUND" in caught.value.message, caught.value.message
+    finally:
+        occlude_marker(stack, "")
+    location = robot.LabwareInventory.LocateLabware(LabwareUniqueID="plate_001").Location
+    assert (location.Aboard, location.Position, location.Index) == (False, "station_a", 1)
+    assert robot.MobileRobotController.OnboardLabware.get() == []
+    expect_defined(  # the failed step ended the handover: prepare again before another GetLabware
+        "InvalidCommandSequence",
+        lambda: manipulator.GetLabware(HandoverPosition=where, IntermediateActions=[]),
+        "needs PrepareForInput first",
+    )
 
 
 def test_stop_motion_cancels_a_drive_through_the_whole_stack(robot: SilaClient) -> None:
