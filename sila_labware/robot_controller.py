@@ -20,7 +20,7 @@ import threading
 from collections.abc import Callable
 
 from ros_bridge.actions import ActionGoal, ActionOutcome, GoalProgress
-from ros_bridge.errors import BridgeTimeout
+from ros_bridge.errors import BridgeError, BridgeTimeout
 from ros_bridge.robot_link import RobotLink
 from ros_bridge.workcell import RobotStatus, WorkcellDescription
 from sila_labware.errors import CommandSequenceError, ParameterError
@@ -269,6 +269,8 @@ class RobotController:
             self.sequence.finish_prepare(success)
 
     def _wait(self, goal: ActionGoal, what: str) -> ActionOutcome:
+        """The goal's outcome; bridge trouble (no answer, rejection, timeout) becomes a failed outcome,
+        so that callers always settle the inventory and raise their own defined error."""
         with self._active_lock:
             self._active_goal = goal
         try:
@@ -276,8 +278,16 @@ class RobotController:
             try:
                 return goal.result(self.step_timeout_s)
             except BridgeTimeout:
+                logger.warning("%s took longer than %.0f s: cancelling it", what, self.step_timeout_s)
                 goal.cancel()
-                raise
+                try:
+                    return goal.result(10.0)
+                except BridgeTimeout:
+                    return ActionOutcome(
+                        False, "TIMEOUT", f"{what}: no result within {self.step_timeout_s:.0f} s", ""
+                    )
+        except BridgeError as error:
+            return ActionOutcome(False, type(error).__name__, str(error), "")
         finally:
             with self._active_lock:
                 self._active_goal = None
