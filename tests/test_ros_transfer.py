@@ -43,7 +43,8 @@ def robot(tmp_path_factory: pytest.TempPathFactory) -> Iterator[RosCaller]:
             caller.close()
             for process, name in ((sim, "sim_node"), (sequencer, "sequencer")):
                 assert process.poll() is None, f"{name} died early; see {logs / (name + '.log')}"
-    for name in ("sim_node", "sequencer"):
+    for process, name in ((sim, "sim_node"), (sequencer, "sequencer")):
+        assert process.returncode == 0, f"{name} did not exit cleanly on SIGTERM: {process.returncode}"
         assert "Traceback" not in (logs / f"{name}.log").read_text(), f"{name} logged a traceback"
 
 
@@ -62,7 +63,9 @@ def placement(robot: RosCaller, station: str = "", sub_position: int = 0) -> Che
 def arm_joints(robot: RosCaller) -> dict[str, float]:
     robot.spin_for(0.3)
     message = robot.latest["/joint_states"]
-    return {n: p for n, p in zip(message.name, message.position) if n.startswith(("arm_", "torso"))}
+    return {
+        n: p for n, p in zip(message.name, message.position, strict=True) if n.startswith(("arm_", "torso"))
+    }
 
 
 def set_parameter(robot: RosCaller, name: str, text: str) -> None:
@@ -75,7 +78,7 @@ def set_parameter(robot: RosCaller, name: str, text: str) -> None:
 def assert_feedback_regular(outcome: object, min_rate_hz: float = 2.0) -> None:
     times = outcome.feedback_times
     assert len(times) >= 3, "too little feedback"
-    gaps = [b - a for a, b in zip(times, times[1:])]
+    gaps = [b - a for a, b in zip(times[:-1], times[1:], strict=True)]
     assert max(gaps) <= 1.0 / min_rate_hz + 0.25, f"feedback gap {max(gaps):.2f} s"
     progress = [f.progress for f in outcome.feedback]
     assert all(0.0 <= p <= 1.0 for p in progress)
@@ -162,3 +165,24 @@ def test_plate_goes_a_to_hotel_to_b_and_back(robot: RosCaller) -> None:
         assert check.location == expected_location, check
         if kind is PutLabware:
             assert check.in_nest, f"not within clearance: {check.position_error_m * 1000:.1f} mm"
+
+
+def test_second_motion_while_busy_is_refused_and_cancel_stops_safely(robot: RosCaller) -> None:
+    handle = robot.send(GetLabware, "/get_labware", task_goal(GetLabware, "station_a", 1, 2))
+    assert handle.accepted
+    outcome = handle.outcome
+    robot.wait_for(
+        lambda: any("approach" in f.phase for f in outcome.feedback), TASK_TIMEOUT_S, "the approach phase"
+    )
+    busy = robot.call_action(PlayMotion, "/play_motion", PlayMotion.Goal(motion_name="Home"), timeout_s=30.0)
+    assert busy.result.error_code == ErrorCodes.BUSY, busy.result.message
+    busy_task = robot.call_action(GetLabware, "/get_labware", task_goal(GetLabware, "station_b", 1, 1))
+    assert busy_task.result.error_code == ErrorCodes.BUSY
+    robot.spin_until(handle.cancel_goal_async(), 30.0)
+    outcome = robot.result(handle, TASK_TIMEOUT_S)
+    assert outcome.status == GoalStatus.STATUS_CANCELED
+    assert outcome.result.error_code == ErrorCodes.CANCELED
+    robot.spin_for(1.0)
+    where = placement(robot).location
+    held = robot.latest["/robot_state"].held_labware_id
+    assert where in ("station:station_a:1", "hotel:2") or (where == "gripper" and held == PLATE), where

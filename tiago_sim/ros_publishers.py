@@ -45,6 +45,7 @@ class RobotSnapshot:
     hotel: list[tuple[int, str, str]]
     held_labware_id: str
     nests: list[tuple[str, int, bool, str]] = field(default_factory=list)
+    true_base_pose: tuple[float, float, float] | None = None  # simulator truth, for measurement only
 
 
 def take_snapshot(sim: Any) -> RobotSnapshot:
@@ -60,6 +61,20 @@ def take_snapshot(sim: Any) -> RobotSnapshot:
         hotel=list(sim.hotel_occupancy()),
         held_labware_id=held,
         nests=list(sim.nest_occupancy()),
+        true_base_pose=_true_base_pose(sim),
+    )
+
+
+def _true_base_pose(sim: Any) -> tuple[float, float, float] | None:
+    """Ground-truth floor pose of the base, if the simulation exposes it (benchmarks only)."""
+    robot = getattr(sim, "robot", None)
+    if robot is None or not hasattr(robot, "base_pose"):
+        return None
+    T_world_base = robot.base_pose()
+    return (
+        float(T_world_base[0, 3]),
+        float(T_world_base[1, 3]),
+        math.atan2(T_world_base[1, 0], T_world_base[0, 0]),
     )
 
 
@@ -110,6 +125,8 @@ class StatePublishers:
         self.joint_pub = node.create_publisher(JointState, "/joint_states", reliable)
         self.robot_state_pub = node.create_publisher(RobotState, "/robot_state", reliable)
         self.station_pub = node.create_publisher(StationStates, "/station_states", reliable)
+        # Simulator truth, like Gazebo's ground-truth plugins: for benchmarks, never for the robot.
+        self.truth_pub = node.create_publisher(Pose2D, "/ground_truth/base_pose", reliable)
         self.image_pub = node.create_publisher(Image, CAMERA_IMAGE_TOPIC, 2)
         self.info_pub = node.create_publisher(CameraInfo, CAMERA_INFO_TOPIC, 2)
         self._last_robot_key: tuple | None = None
@@ -153,6 +170,9 @@ class StatePublishers:
             self._last_robot_key = key
         if slow_due:
             self._last_slow_publish = now
+            if snapshot.true_base_pose is not None:
+                x, y, yaw = snapshot.true_base_pose
+                self.truth_pub.publish(Pose2D(x=x, y=y, theta=yaw))
             self.station_pub.publish(self.station_states(snapshot))
 
     def _publish_odometry(self, snapshot: RobotSnapshot, stamp: Time) -> None:
