@@ -13,6 +13,7 @@ import json
 import logging
 import signal
 import sys
+import tempfile
 import threading
 from collections.abc import Sequence
 from pathlib import Path
@@ -57,8 +58,9 @@ def build_parser() -> argparse.ArgumentParser:
         sub.add_argument(
             "--ca-file",
             type=Path,
-            default=Path("sila-labware-ca.pem"),
-            help="where to write the CA for clients",
+            default=None,
+            help="where to write the CA certificate clients trust "
+            "(default: ./sila-labware-ca.pem for serve, a temporary file for demo)",
         )
         sub.add_argument("--no-discovery", action="store_true", help="do not announce the servers (mDNS)")
         sub.add_argument(
@@ -123,13 +125,21 @@ def _deployment_from(args: argparse.Namespace):
             host=args.host,
             port_base=args.port_base,
             insecure=args.insecure,
-            ca_file=args.ca_file,
+            ca_file=_ca_file(args),
             discovery=not args.no_discovery,
             domain_id=args.domain_id,
             ready_timeout_s=args.ready_timeout,
             log_dir=args.log_dir,
         )
     )
+
+
+def _ca_file(args: argparse.Namespace) -> Path:
+    if args.ca_file is not None:
+        return args.ca_file
+    if args.command == "demo":
+        return Path(tempfile.mkdtemp(prefix="sila-labware-demo-")) / "ca.pem"
+    return Path("sila-labware-ca.pem")
 
 
 def _print_servers(deployment, stream) -> None:
