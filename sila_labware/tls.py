@@ -13,6 +13,7 @@ from __future__ import annotations
 import datetime
 import ipaddress
 import logging
+import socket
 from dataclasses import dataclass
 from pathlib import Path
 from uuid import UUID
@@ -43,19 +44,33 @@ def _name(common_name: str) -> x509.Name:
     )
 
 
+def _machine_addresses() -> set[str]:
+    """This machine's IPv4 addresses by its host name (for servers bound to 0.0.0.0)."""
+    try:
+        infos = socket.getaddrinfo(socket.gethostname(), None, socket.AF_INET)
+    except OSError:
+        return set()
+    return {str(info[4][0]) for info in infos}
+
+
 def _subject_alternative_names(host: str) -> list[x509.GeneralName]:
-    names: list[x509.GeneralName] = [
-        x509.DNSName("localhost"),
-        x509.IPAddress(ipaddress.ip_address("127.0.0.1")),
-    ]
+    """Names a client may use to reach the server: loopback always, plus the bound address or,
+    for an unspecified bind address, the host name and its addresses."""
+    dns_names = {"localhost"}
+    addresses = {"127.0.0.1"}
     try:
         address = ipaddress.ip_address(host)
     except ValueError:
-        names.append(x509.DNSName(host))
+        dns_names.add(host)
     else:
-        if str(address) != "127.0.0.1" and not address.is_unspecified:
-            names.append(x509.IPAddress(address))
-    return names
+        if address.is_unspecified:
+            dns_names.add(socket.gethostname())
+            addresses |= _machine_addresses()
+        else:
+            addresses.add(str(address))
+    return [x509.DNSName(name) for name in sorted(dns_names)] + [
+        x509.IPAddress(ipaddress.ip_address(value)) for value in sorted(addresses)
+    ]
 
 
 class CertificateAuthority:
