@@ -1,1 +1,7 @@
-"""ros_bridge package."""
+"""The SiLA-ROS bridge: the robot side's ROS 2 actions, services and topics, usable from any thread.
+
+Knows the labware_interfaces contract and nothing of the simulation or of SiLA. One
+`runtime.RosRuntime` owns rclpy (one context, node and executor on one thread); `actions`,
+`services` and `topics` are thread-safe callers on top of it; `robot_link.RobotLink` names the
+robot's interfaces and returns the plain snapshots of `workcell`.
+"""
