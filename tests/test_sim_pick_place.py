@@ -121,3 +121,21 @@ def test_closing_on_nothing_reports_not_holding():
         assert sim.grippers[ARM].opening() == pytest.approx(0.1, abs=0.001)
     finally:
         sim.close()
+
+
+def test_nest_lead_ins_guide_a_plate_released_off_centre():
+    """Perception and odometry leave millimetres of error: the chamfered nest must absorb them."""
+    world = load_world()
+    sim = Simulation(world, seed=5)
+    script = Script(sim)
+    try:
+        script.run(sim.undock(), "undock")
+        script.drive("station_a_work")
+        script.pick(script.site_in_base("station_a", 1))
+        error = tf.from_xyz_rpy((-0.004, 0.003, 0.0), (0.0, 0.0, np.radians(1.5)))
+        script.place(script.site_in_base("station_a", 2) @ error)
+        check = sim.check_placement(PLATE, "station_a", 2)
+        assert check.in_nest, check
+        assert check.position_error_m < 0.0025
+    finally:
+        sim.close()

@@ -2,13 +2,16 @@
 
 Why separate from the robot: the lab is pure world data (floor, dock, tables, nests, markers,
 plates); the Simulation adds the robot on top. Call on the thread that owns the client.
-Nests are four corner L-brackets around a pocket (plate size + clearance), which leave the middle
-of the plate's long sides free for the finger pads.
+Nests are four corner L-brackets around a pocket (plate size + clearance) with 45 deg lead-in
+chamfers of low friction, as real SBS nests have: a plate released a few millimetres or a degree
+or two off centre slides into the pocket. The brackets leave the middle of the plate's long
+sides free for the finger pads.
 """
 
 from __future__ import annotations
 
 import logging
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -16,14 +19,18 @@ import pybullet as p
 
 from tiago_sim import transforms as tf
 from tiago_sim.perception.marker_asset import marker_visual
-from tiago_sim.robot_model import BASE_RADIUS, corner_bracket_boxes
+from tiago_sim.robot_model import BASE_RADIUS
 from tiago_sim.world import LabwareType, Station, World
 
 log = logging.getLogger(__name__)
 
 PLATE_FRICTION = 1.0
 PLATE_SPINNING_FRICTION = 0.02
-NEST_BRACKET_HEIGHT = 0.006
+NEST_WALL_HEIGHT = 0.0015  # vertical part of a bracket at the pocket edge; the lead-in chamfer sits on top
+NEST_LEAD_IN = 0.006  # per side, 45 deg: the opening is this much wider than the pocket on each side
+NEST_LEG_LENGTH = 0.015  # bracket legs run this far in from each corner
+NEST_FRICTION = 0.15  # polished lead-ins: with the plate's 1.0, the pair's friction is 0.15
+TABLE_FRICTION = 0.3  # laminate bench top: plate on table 0.3
 DOCK_GAP = 0.002  # between the docked robot's rear and the dock's contact plate
 DOCK_SIZE = (0.10, 0.45, 0.30)
 
@@ -51,18 +58,57 @@ def _static_box(client: int, size, T_world_box: np.ndarray, rgba, collide: bool 
     return p.createMultiBody(0.0, collision, visual, position.tolist(), quat.tolist(), physicsClientId=client)
 
 
+def nest_boxes(length: float, width: float) -> list[tuple[tuple, tuple, tuple]]:
+    """Boxes (size, centre, quaternion) of a nest: four corner L-brackets with 45 deg lead-ins.
+
+    Each bracket leg is a wall ``NEST_WALL_HEIGHT`` high at the pocket edge with a chamfer plate
+    on top that widens the opening by ``NEST_LEAD_IN`` per side, so a plate released up to
+    clearance + lead-in off centre slides into the pocket (low-friction bracket material).
+    """
+    boxes = []
+    wall, leg, lead, thick, h = 0.006, NEST_LEG_LENGTH, NEST_LEAD_IN, 0.003, NEST_WALL_HEIGHT
+    slope = lead * math.sqrt(2.0)
+    flat = (0.0, 0.0, 0.0, 1.0)
+    offset = thick / 2 / math.sqrt(2.0)
+    for cx in (-1, 1):
+        for cy in (-1, 1):
+            # leg across the short end (wall normal along x), spanning `leg` in from the corner
+            along_y = cy * (width / 2 - leg / 2 + wall / 2)
+            boxes.append(((wall, leg + wall, h), (cx * (length / 2 + wall / 2), along_y, h / 2), flat))
+            chamfer_x = cx * (length / 2 + lead / 2) + cx * offset
+            quat_x = tf.matrix_to_quat(
+                tf.rpy_to_matrix(0.0, -math.pi / 4 if cx > 0 else -3 * math.pi / 4, 0.0)
+            )
+            boxes.append(
+                ((slope, leg + wall, thick), (chamfer_x, along_y, h + lead / 2 - offset), tuple(quat_x))
+            )
+            # leg along the long side (wall normal along y)
+            along_x = cx * (length / 2 - leg / 2)
+            boxes.append(((leg, wall, h), (along_x, cy * (width / 2 + wall / 2), h / 2), flat))
+            chamfer_y = cy * (width / 2 + lead / 2) + cy * offset
+            quat_y = tf.matrix_to_quat(tf.rpy_to_matrix(math.pi / 4 if cy > 0 else 3 * math.pi / 4, 0.0, 0.0))
+            boxes.append(((leg, slope, thick), (along_x, chamfer_y, h + lead / 2 - offset), tuple(quat_y)))
+    return boxes
+
+
 def _compound_static(client: int, boxes, T_world_body: np.ndarray, rgba) -> int:
-    """One static body made of several boxes given as (size, centre) in the body frame."""
-    halves = [[s / 2 for s in size] for size, _ in boxes]
-    centres = [list(centre) for _, centre in boxes]
+    """One static body made of several boxes given as (size, centre[, quaternion]) in the body frame."""
+    halves = [[s / 2 for s in box[0]] for box in boxes]
+    centres = [list(box[1]) for box in boxes]
+    orientations = [list(box[2]) if len(box) > 2 else [0, 0, 0, 1] for box in boxes]
     shapes = [p.GEOM_BOX] * len(boxes)
     collision = p.createCollisionShapeArray(
-        shapes, halfExtents=halves, collisionFramePositions=centres, physicsClientId=client
+        shapes,
+        halfExtents=halves,
+        collisionFramePositions=centres,
+        collisionFrameOrientations=orientations,
+        physicsClientId=client,
     )
     visual = p.createVisualShapeArray(
         shapes,
         halfExtents=halves,
         visualFramePositions=centres,
+        visualFrameOrientations=orientations,
         rgbaColors=[rgba] * len(boxes),
         physicsClientId=client,
     )
@@ -79,6 +125,7 @@ def _build_station(client: int, station: Station, labware: LabwareType, scene: S
         T_world_top @ tf.make_transform((0, 0, -height / 2)),
         [0.75, 0.7, 0.6, 1],
     )
+    p.changeDynamics(scene.tables[station.name], -1, lateralFriction=TABLE_FRICTION, physicsClientId=client)
     # marker on a thin board standing behind it
     T_world_marker = station.T_world_marker()
     board = station.marker_size * 1.4
@@ -88,11 +135,11 @@ def _build_station(client: int, station: Station, labware: LabwareType, scene: S
     T_world_tile = T_world_marker @ tf.make_transform((0, 0, 0.0008))
     scene.markers[station.name] = marker_visual(client, station.marker_id, station.marker_size, T_world_tile)
     pocket = (labware.length + 2 * station.nest_clearance, labware.width + 2 * station.nest_clearance)
-    boxes = corner_bracket_boxes(pocket[0], pocket[1], NEST_BRACKET_HEIGHT)
+    boxes = nest_boxes(pocket[0], pocket[1])
     for sub in range(1, station.sub_positions + 1):
-        scene.nests[(station.name, sub)] = _compound_static(
-            client, boxes, station.T_world_site(sub), [0.25, 0.25, 0.28, 1]
-        )
+        nest = _compound_static(client, boxes, station.T_world_site(sub), [0.25, 0.25, 0.28, 1])
+        p.changeDynamics(nest, -1, lateralFriction=NEST_FRICTION, physicsClientId=client)
+        scene.nests[(station.name, sub)] = nest
 
 
 def _plate_body(client: int, labware: LabwareType, T_world_bottom: np.ndarray) -> int:
