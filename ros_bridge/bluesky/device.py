@@ -117,6 +117,12 @@ class LabwareTransferRobot(Device):
         if latest is not None:
             self._report_robot_status(latest)
 
+    @property
+    def current_status(self) -> ActionStatus | None:
+        """The status of the latest task sent (running or ended), None before the first."""
+        with self._running_lock:
+            return self._running[-1] if self._running else None
+
     # --- bluesky Movable / Stoppable / Triggerable ---
 
     def set(self, value: str | TransferTask | Mapping[str, Any], **_kwargs: Any) -> ActionStatus:

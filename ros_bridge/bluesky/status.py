@@ -163,6 +163,8 @@ class ActionStatus(DeviceStatus):
         )
 
     def __str__(self) -> str:
-        return f"ActionStatus({self.label}, done={self.done}, success={self.success})"
+        # bluesky puts str(status) into the run's stop document: say why it failed.
+        error = f", error={self._exception}" if self.done and self._exception is not None else ""
+        return f"ActionStatus({self.label}, done={self.done}, success={self.success}{error})"
 
     __repr__ = __str__
