@@ -3,7 +3,7 @@
 sim_node and sequencer run as real processes; the robot device talks to them only through the
 ROS bridge. Ground truth (/check_placement) judges where the plate ends up. The tests share
 the processes and run in file order: refusal (robot still docked), stop during the drive,
-the full plan, and last an occluded marker at station A (where the full plan leaves the robot).
+the demo's full plan, and last an occluded marker at station A (where the full plan leaves the robot).
 """
 
 from __future__ import annotations
@@ -11,6 +11,7 @@ from __future__ import annotations
 import threading
 import time
 from collections.abc import Iterator
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -22,11 +23,12 @@ from rcl_interfaces.srv import SetParameters
 from ros_processes import running
 
 from ros_bridge.bluesky import ActionFailed, LabwareTransferRobot, NestSite, sample_exchange_plan
-from ros_bridge.bluesky.demo import find_exchange_setup
+from ros_bridge.bluesky.demo import MEASURE_POSITION_M, find_exchange_setup, run_bluesky_demo
 from ros_bridge.robot_link import RobotLink
 from ros_bridge.runtime import RosRuntime
 from ros_bridge.services import ServiceCaller
 
+DEFAULT_WORLD = Path(__file__).resolve().parents[1] / "tiago_sim" / "worlds" / "default.yaml"
 PLATE = "plate_001"
 STORAGE = NestSite("station_a", 1)
 BEAM = NestSite("station_b", 1)
@@ -92,6 +94,18 @@ def assert_plate_in(link: RobotLink, site: NestSite) -> None:
     assert check.in_nest, f"plate not in {site}: {check}"
 
 
+def set_sim_parameter(link: RobotLink, name: str, value: str | float) -> None:
+    caller = ServiceCaller(link.runtime, SetParameters, "/tiago_sim/set_parameters")
+    caller.wait_for_service(10.0)
+    if isinstance(value, str):
+        parameter_value = ParameterValue(type=ParameterType.PARAMETER_STRING, string_value=value)
+    else:
+        parameter_value = ParameterValue(type=ParameterType.PARAMETER_DOUBLE, double_value=float(value))
+    request = SetParameters.Request(parameters=[Parameter(name=name, value=parameter_value)])
+    response = caller.call(request, 10.0)
+    assert response.results[0].successful, response.results[0].reason
+
+
 def test_the_workcell_offers_the_exchange_the_tests_assume(link: RobotLink) -> None:
     setup = find_exchange_setup(link)
     assert (setup.labware_id, setup.storage, setup.beam, setup.hotel_slot) == (PLATE, STORAGE, BEAM, 1)
@@ -119,17 +133,23 @@ def test_pause_and_abort_while_driving_cancels_the_goal_and_the_robot_stops(link
         while time.monotonic() < deadline:
             status = robot.current_status
             if status is not None and status.progress.phase.startswith("driving"):
-                time.sleep(1.0)  # well into the drive
+                time.sleep(0.5)  # well into the drive
                 engine.request_pause(defer=False)
                 return
             time.sleep(0.05)
 
     pauser = threading.Thread(target=pause_once_driving, daemon=True)
     pauser.start()
-    with pytest.raises(RunEngineInterrupted):
-        engine(exchange(robot))
-    pauser.join(timeout=5.0)
-    engine.abort("test: operator abort while driving")
+    # The simulation runs faster than real time when it can: hold it to real time so the
+    # drive (several metres) is surely still under way when the pause comes.
+    set_sim_parameter(link, "realtime_factor_cap", 1.0)
+    try:
+        with pytest.raises(RunEngineInterrupted):
+            engine(exchange(robot))
+        pauser.join(timeout=5.0)
+        engine.abort("test: operator abort while driving")
+    finally:
+        set_sim_parameter(link, "realtime_factor_cap", 0.0)
 
     status = robot.current_status
     assert status is not None and status.label.startswith("pickup")
@@ -147,8 +167,8 @@ def test_pause_and_abort_while_driving_cancels_the_goal_and_the_robot_stops(link
     assert_plate_in(link, STORAGE)
 
 
-def test_sample_exchange_plan_measures_and_returns_the_plate(link: RobotLink) -> None:
-    engine, documents = make_engine()
+def test_bluesky_demo_measures_and_returns_the_plate(link: RobotLink) -> None:
+    documents = Documents()
     progress_reports: list[dict[str, Any]] = []
 
     def watch_statuses(statuses: Any) -> None:
@@ -156,17 +176,19 @@ def test_sample_exchange_plan_measures_and_returns_the_plate(link: RobotLink) ->
             if hasattr(status, "watch"):
                 status.watch(lambda **report: progress_reports.append(report))
 
-    engine.waiting_hook = watch_statuses
-    robot = make_robot(link)
-    engine(exchange(robot))
+    exit_code = run_bluesky_demo(
+        DEFAULT_WORLD, ready_timeout_s=30.0, waiting_hook=watch_statuses, document_callbacks=[documents]
+    )
+    assert exit_code == 0
 
     (stop,) = documents.of("stop")
     assert stop["exit_status"] == "success", stop
     (start,) = documents.of("start")
     assert start["labware_id"] == PLATE and start["storage_site"] == "station_a/1"
+    assert start["beam_site"] == "station_b/1" and start["world"] == str(DEFAULT_WORLD)
     (measurement,) = documents.events("primary")
-    assert measurement["data"]["detector"] == pytest.approx(1000.0)
-    assert measurement["data"]["stage"] == pytest.approx(MEASURE_M)
+    assert measurement["data"]["detector"] == pytest.approx(1.0e5)
+    assert measurement["data"]["stage"] == pytest.approx(MEASURE_POSITION_M)
     assert measurement["data"]["robot_state"] == "idle"
     assert measurement["data"]["robot_carried_labware"] == ""
     assert measurement["data"]["robot_current_poi"] == "station_b_work"
@@ -178,22 +200,12 @@ def test_sample_exchange_plan_measures_and_returns_the_plate(link: RobotLink) ->
         ("return_place", ""),
     ]
     assert robot_events[-1]["data"]["robot_current_poi"] == "station_a_work"
-    robot_progress = [
-        r for r in progress_reports if r.get("name", "").startswith("robot ") and "current" in r
-    ]
+    robot_progress = [r for r in progress_reports if "current" in r and r["name"].startswith("robot ")]
     for task in ("pickup", "place", "return_pickup", "return_place"):
         currents = [r["current"] for r in robot_progress if r["name"].startswith(f"robot {task} ")]
         assert currents and currents[-1] == 100.0 and min(currents) < 50.0, (task, currents[:5])
     assert_plate_in(link, STORAGE)
     assert PLATE not in link.robot_status().onboard_labware_ids
-
-
-def set_sim_parameter(link: RobotLink, name: str, text: str) -> None:
-    caller = ServiceCaller(link.runtime, SetParameters, "/tiago_sim/set_parameters")
-    caller.wait_for_service(10.0)
-    value = ParameterValue(type=ParameterType.PARAMETER_STRING, string_value=text)
-    response = caller.call(SetParameters.Request(parameters=[Parameter(name=name, value=value)]), 10.0)
-    assert response.results[0].successful, response.results[0].reason
 
 
 def test_occluded_marker_fails_the_plan_and_leaves_the_plate(link: RobotLink) -> None:

@@ -16,6 +16,7 @@ from __future__ import annotations
 import logging
 import threading
 import time
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -124,8 +125,15 @@ def run_bluesky_demo(
     ready_timeout_s: float = 180.0,
     task_timeout_s: float = 600.0,
     progress_bar: bool = False,
+    waiting_hook: Callable[[Any], None] | None = None,
+    document_callbacks: Sequence[Callable[[str, dict[str, Any]], None]] = (),
 ) -> int:
-    """Run the sample exchange plan on a RunEngine; 0 only if the plate ends in its starting nest."""
+    """Run the sample exchange plan on a RunEngine; 0 only if the plate ends in its starting nest.
+
+    `progress_bar` draws bluesky's terminal progress bars (stdout); `waiting_hook` replaces them
+    with your own (called with the status objects being waited on). `document_callbacks` get
+    every document of the run, after the demo's own log lines.
+    """
     started = time.monotonic()
     runtime = RosRuntime(node_name="bluesky_bridge", domain_id=domain_id).start()
     try:
@@ -143,9 +151,13 @@ def run_bluesky_demo(
         # Ctrl-C pauses the RunEngine (its SIGINT handler, main thread only); we then abort.
         on_main_thread = threading.current_thread() is threading.main_thread()
         engine = RunEngine({}) if on_main_thread else RunEngine({}, context_managers=[])
-        if progress_bar:
+        if waiting_hook is not None:
+            engine.waiting_hook = waiting_hook
+        elif progress_bar:
             engine.waiting_hook = ProgressBarManager()
         engine.subscribe(DocumentLog())
+        for callback in document_callbacks:
+            engine.subscribe(callback)
         plan = sample_exchange_plan(
             robot,
             stage,
