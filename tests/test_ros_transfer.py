@@ -17,7 +17,9 @@ from labware_interfaces.srv import CheckPlacement, DescribeWorkcell
 from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
 from rcl_interfaces.srv import SetParameters
 from ros_processes import RosCaller, running
-from sensor_msgs.msg import JointState
+from sensor_msgs.msg import CameraInfo, Image, JointState
+
+from tiago_sim.ros_publishers import CAMERA_IMAGE_TOPIC, CAMERA_INFO_TOPIC
 
 PLATE = "plate_001"
 TASK_TIMEOUT_S = 240.0
@@ -92,6 +94,42 @@ def test_describe_workcell_lists_the_world(robot: RosCaller) -> None:
         "station_b": (2, "station_b_work"),
     }
     assert response.hotel_slots == 2 and response.dock_poi in response.pois
+
+
+def test_robot_starts_docked_with_an_empty_hotel(robot: RosCaller) -> None:
+    state = robot.latest["/robot_state"]
+    assert state.state == RobotState.STATE_DOCKED
+    assert [(slot.index, slot.labware_id) for slot in state.hotel] == [(1, ""), (2, "")]
+    nests = {(n.station, n.sub_position): n for n in robot.latest["/station_states"].nests}
+    assert nests[("station_a", 1)].occupied and nests[("station_a", 1)].labware_id == PLATE
+    assert not nests[("station_b", 1)].occupied
+
+
+def test_head_camera_is_published_when_subscribed(robot: RosCaller) -> None:
+    robot.subscribe(Image, CAMERA_IMAGE_TOPIC)
+    robot.subscribe(CameraInfo, CAMERA_INFO_TOPIC)
+    robot.wait_for(
+        lambda: CAMERA_IMAGE_TOPIC in robot.latest and CAMERA_INFO_TOPIC in robot.latest, 20.0, "camera"
+    )
+    image, info = robot.latest[CAMERA_IMAGE_TOPIC], robot.latest[CAMERA_INFO_TOPIC]
+    assert (image.width, image.height, image.encoding) == (640, 480, "rgb8")
+    assert len(image.data) == 640 * 480 * 3 and len(set(bytes(image.data[::997]))) > 10  # not blank
+    assert info.k[0] == pytest.approx(522.2, abs=1.0)
+
+
+def test_parameters_are_checked_and_applied_at_runtime(robot: RosCaller) -> None:
+    value = ParameterValue(type=ParameterType.PARAMETER_DOUBLE, double_value=50.0)
+    request = SetParameters.Request(parameters=[Parameter(name="speed_scale", value=value)])
+    response = robot.call_service(SetParameters, "/tiago_sim/set_parameters", request)
+    assert not response.results[0].successful and "speed_scale" in response.results[0].reason
+    pose = ParameterValue(type=ParameterType.PARAMETER_DOUBLE_ARRAY, double_array_value=[0.0, 2.0, 0.0])
+    request = SetParameters.Request(parameters=[Parameter(name="pois.spare_corner", value=pose)])
+    response = robot.call_service(SetParameters, "/tiago_sim/set_parameters", request)
+    assert not response.results[0].successful  # POIs are declared from the world file only
+    estimate = ParameterValue(type=ParameterType.PARAMETER_DOUBLE, double_value=25.0)
+    request = SetParameters.Request(parameters=[Parameter(name="estimates_s.navigate", value=estimate)])
+    response = robot.call_service(SetParameters, "/labware_sequencer/set_parameters", request)
+    assert response.results[0].successful
 
 
 def test_unknown_poi_is_aborted_with_reason(robot: RosCaller) -> None:
