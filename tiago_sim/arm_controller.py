@@ -14,7 +14,7 @@ import numpy as np
 from tiago_sim.motion import CANCELED, Motion
 from tiago_sim.robot_body import RobotBody
 
-SETTLE_TOLERANCE = 0.01  # rad (or m for the torso)
+SETTLE_TOLERANCE = 0.02  # rad (m for the torso): goal tolerance, as a joint trajectory controller has
 SETTLE_TIMEOUT_S = 1.5
 
 
