@@ -1,12 +1,14 @@
 """ActionStatus and the robot device's readings against a real rclpy peer in another process.
 
 The peer (tests/ros_echo_server.py) serves /navigate_to_poi with feedback at 20 Hz for 2 s per
-goal and publishes /robot_state at 10 Hz: quick, real DDS, no simulation needed.
+goal and publishes /robot_state at 10 Hz (and serves no task-level actions): quick, real DDS,
+no simulation needed.
 """
 
 from __future__ import annotations
 
 import io
+import logging
 import subprocess
 import sys
 import time
@@ -24,6 +26,7 @@ from ophyd.utils import StatusTimeoutError
 
 from ros_bridge.actions import ActionCaller
 from ros_bridge.bluesky import ActionFailed, ActionStatus, LabwareTransferRobot, NestSite
+from ros_bridge.bluesky.demo import run_bluesky_demo
 from ros_bridge.robot_link import RobotLink
 from ros_bridge.runtime import RosRuntime
 
@@ -168,3 +171,12 @@ def test_robot_device_reads_robot_state_and_refuses_unknown_tasks(runtime: RosRu
     assert set(robot.hints["fields"]) == {"robot_state", "robot_carried_labware"}
     with pytest.raises(ValueError, match="unknown task 'dance'"):
         robot.set("dance")
+
+
+def test_demo_without_the_task_servers_exits_1_naming_what_is_missing(
+    runtime: RosRuntime, caplog: pytest.LogCaptureFixture
+) -> None:
+    world = Path(__file__).resolve().parents[1] / "tiago_sim" / "worlds" / "default.yaml"
+    with caplog.at_level(logging.ERROR, logger="ros_bridge.bluesky.demo"):
+        assert run_bluesky_demo(world, ready_timeout_s=1.0) == 1
+    assert "action server /dock (Dock) not available" in caplog.text
