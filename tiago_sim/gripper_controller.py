@@ -18,6 +18,7 @@ PAD_SPINNING_FRICTION = 0.02
 STALL_SPEED = 0.002  # m/s: fingers count as stopped below this
 STALL_TIME_S = 0.15
 ATTACH_FORCE = 60.0  # N
+GEAR_FORCE = 5.0  # N: keeps the fingers in step in free motion, yields so both pads reach an off-centre plate
 
 
 class Gripper:
@@ -53,7 +54,7 @@ class Gripper:
             [0, 0, 0],
             physicsClientId=client,
         )
-        p.changeConstraint(gear, gearRatio=-1, maxForce=100.0, erp=0.2, physicsClientId=client)
+        p.changeConstraint(gear, gearRatio=-1, maxForce=GEAR_FORCE, erp=0.2, physicsClientId=client)
         self.command(rm.FINGER_TRAVEL)
 
     def command(self, finger_position: float) -> None:
@@ -120,6 +121,7 @@ class GripperMotion(Motion):
         self.holding = False
         self.opening_m = gripper.opening()
         self.stall_s = 0.0
+        self.history: list[list[float]] = []
         self.phase = "closing" if close else "opening"
         if not close:
             gripper.detach()
@@ -138,10 +140,20 @@ class GripperMotion(Motion):
         remaining = abs(sum(gripper.body.joint_positions()[n] for n in gripper.fingers) / 2 - target)
         self.progress = float(min(0.99, 1.0 - remaining / rm.FINGER_TRAVEL))
         self.remaining_s = remaining / rm.FINGER_SPEED + 0.2
-        speed = abs(gripper.body.joint_velocities(gripper.fingers)).max()
+        # stall from the fingers' travel over the last STALL_TIME_S (reported joint velocities jitter
+        # while the gear constraint and the contacts balance)
+        positions = [gripper.body.joint_positions()[n] for n in gripper.fingers]
+        self.history.append(positions)
+        window = max(1, int(STALL_TIME_S / dt))
+        del self.history[: -window - 1]
+        travel = max(abs(a - b) for a, b in zip(self.history[0], positions, strict=True))
         started = self.elapsed_s > 0.25  # fingers are at rest before they start to move
-        self.stall_s = self.stall_s + dt if (speed < STALL_SPEED and started) else 0.0
-        if remaining < 5e-4 or self.stall_s > STALL_TIME_S:
+        moving = len(self.history) <= window or travel > STALL_SPEED * STALL_TIME_S
+        self.stall_s = self.stall_s + dt if (started and not moving) else 0.0
+        timed_out = (
+            self.elapsed_s > rm.FINGER_TRAVEL / rm.FINGER_SPEED + 1.0
+        )  # fingers pressing but jittering
+        if remaining < 5e-4 or self.stall_s > 0.0 or timed_out:
             if self.close:
                 labware_id = gripper.touching()
                 self.holding = bool(labware_id) and self.opening_m > 2 * rm.FINGER_MOUNT_OFFSET + 0.002
