@@ -139,3 +139,26 @@ def test_nest_lead_ins_guide_a_plate_released_off_centre():
         assert check.position_error_m < 0.0025
     finally:
         sim.close()
+
+
+def test_grasp_holds_a_plate_when_the_gripper_arrives_off_centre():
+    """Both pads must reach the plate even when the tool is millimetres and a degree or two off."""
+    world = load_world()
+    sim = Simulation(world, seed=9)
+    script = Script(sim)
+    try:
+        script.run(sim.undock(), "undock")
+        script.drive("station_a_work")
+        error = tf.from_xyz_rpy((0.002, -0.003, 0.0), (0.0, 0.0, np.radians(1.5)))
+        T_base_site = script.site_in_base("station_a", 1) @ error
+        script.run(sim.move_tool(ARM, script.grasp(T_base_site, APPROACH), straight_line=False), "approach")
+        script.run(sim.move_tool(ARM, script.grasp(T_base_site)), "descend")
+        closed = script.run(sim.gripper(ARM, close=True), "close")
+        assert closed.holding and 0.085 < closed.opening_m < 0.090
+        before = script.plate_in_grasp()
+        script.run(sim.move_tool(ARM, script.grasp(T_base_site, CARRY)), "lift")
+        assert sim.held_labware(ARM) == PLATE
+        assert sim.check_placement(PLATE, "", 0).location == "gripper"
+        assert np.linalg.norm(script.plate_in_grasp()[:3, 3] - before[:3, 3]) < 0.002
+    finally:
+        sim.close()
