@@ -226,7 +226,8 @@ class Sequencer:
                     if goal_handle.is_cancel_requested:
                         raise StepFailed(ErrorCodes.CANCELED, f"canceled before {step.describe()}")
                     await self._run_step(run, step)
-                run.index = len(plan)
+                run.index, run.phase = len(plan), "done"
+                run.publish()  # the last word is progress 1.0
                 return self._finish(goal_handle, result, "", "done")
             except StepFailed as failure:
                 return self._finish(goal_handle, result, failure.code, failure.message)
