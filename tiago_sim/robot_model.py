@@ -28,7 +28,7 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
+from tiago_sim.urdf_writer import UrdfWriter
 
 ARM_SIDES = ("right", "left")
 DEG = math.pi / 180.0
@@ -109,93 +109,7 @@ def finger_joint_names(side: str) -> list[str]:
     return [f"gripper_{side}_left_finger_joint", f"gripper_{side}_right_finger_joint"]
 
 
-def _fmt(values) -> str:
-    return " ".join(f"{float(v):.10g}" for v in values)
-
-
-def _rpy_aligning_z(direction: np.ndarray) -> tuple[float, float, float]:
-    """URDF rpy that turns the z axis onto ``direction`` (for cylinders along a segment)."""
-    d = direction / np.linalg.norm(direction)
-    pitch = math.acos(max(-1.0, min(1.0, d[2])))
-    yaw = math.atan2(d[1], d[0])
-    return (0.0, pitch, yaw)
-
-
-class _UrdfWriter:
-    """Accumulates links and joints; keeps the geometry helpers in one place."""
-
-    def __init__(self, name: str) -> None:
-        self.parts: list[str] = [f'<?xml version="1.0"?>\n<robot name="{name}">']
-        self.parts.append(
-            '<material name="dark"><color rgba="0.2 0.2 0.22 1"/></material>'
-            '<material name="white"><color rgba="0.9 0.9 0.9 1"/></material>'
-            '<material name="grey"><color rgba="0.55 0.55 0.58 1"/></material>'
-            '<material name="pad"><color rgba="0.1 0.35 0.6 1"/></material>'
-        )
-
-    @staticmethod
-    def geometry(shape: str, size) -> str:
-        if shape == "box":
-            return f'<box size="{_fmt(size)}"/>'
-        if shape == "cylinder":
-            return f'<cylinder radius="{size[0]:.6g}" length="{size[1]:.6g}"/>'
-        return f'<sphere radius="{size[0]:.6g}"/>'
-
-    def link(self, name: str, mass: float = 0.0, shapes=(), collide: bool = True) -> None:
-        """A link with ``shapes`` = [(shape, size, xyz, rpy, material)] used for visual and collision."""
-        body = [f'<link name="{name}">']
-        if mass <= 0.0:  # frames: a token mass keeps PyBullet from treating them as static
-            mass = 0.001
-        if mass > 0.0:
-            inertia = max(mass * 0.002, 1e-6)
-            body.append(
-                f'<inertial><origin xyz="0 0 0"/><mass value="{mass:.6g}"/>'
-                f'<inertia ixx="{inertia:.6g}" iyy="{inertia:.6g}" izz="{inertia:.6g}" '
-                'ixy="0" ixz="0" iyz="0"/></inertial>'
-            )
-        for shape, size, xyz, rpy, material in shapes:
-            geometry = self.geometry(shape, size)
-            origin = f'<origin xyz="{_fmt(xyz)}" rpy="{_fmt(rpy)}"/>'
-            body.append(
-                f'<visual>{origin}<geometry>{geometry}</geometry><material name="{material}"/></visual>'
-            )
-            if collide:
-                body.append(f"<collision>{origin}<geometry>{geometry}</geometry></collision>")
-        body.append("</link>")
-        self.parts.append("".join(body))
-
-    def joint(
-        self, name: str, kind: str, parent: str, child: str, xyz=(0, 0, 0), rpy=(0, 0, 0), **opts
-    ) -> None:
-        text = [
-            f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
-            f'<origin xyz="{_fmt(xyz)}" rpy="{_fmt(rpy)}"/>'
-        ]
-        if kind != "fixed":
-            text.append(f'<axis xyz="{_fmt(opts.get("axis", (0, 0, 1)))}"/>')
-            lower, upper = opts.get("limits", (0.0, 0.0))
-            text.append(
-                f'<limit lower="{lower:.10g}" upper="{upper:.10g}" '
-                f'effort="{opts.get("effort", 10.0):.6g}" velocity="{opts.get("velocity", 1.0):.6g}"/>'
-            )
-            text.append('<dynamics damping="0.5" friction="0.0"/>')
-        text.append("</joint>")
-        self.parts.append("".join(text))
-
-    def segment_shapes(self, end_xyz, radius: float, material: str = "white"):
-        """A cylinder from the link origin to ``end_xyz`` (the next joint), plus a joint sphere."""
-        end = np.asarray(end_xyz, dtype=float)
-        length = float(np.linalg.norm(end))
-        shapes = [("sphere", (radius,), (0, 0, 0), (0, 0, 0), "dark")]
-        if length > 1e-6:
-            shapes.append(("cylinder", (radius, length), tuple(end / 2), _rpy_aligning_z(end), material))
-        return shapes
-
-    def text(self) -> str:
-        return "\n".join(self.parts + ["</robot>"])
-
-
-def _add_base(w: _UrdfWriter) -> None:
+def _add_base(w: UrdfWriter) -> None:
     w.link("base_footprint", 1.0)  # its inertial origin makes PyBullet's base frame = base_footprint
     w.link(
         "base_link",
@@ -227,7 +141,7 @@ def _add_base(w: _UrdfWriter) -> None:
         w.joint(f"caster_{i + 1}_joint", "fixed", "base_link", f"caster_{i + 1}_link", (cx, cy, -0.0735))
 
 
-def _add_torso_and_head(w: _UrdfWriter) -> None:
+def _add_torso_and_head(w: UrdfWriter) -> None:
     w.link("torso_fixed_link", 8.0, [("box", (0.24, 0.3, 0.5), (0, 0, 0.23), (0, 0, 0), "grey")])
     w.joint("torso_fixed_joint", "fixed", "base_link", "torso_fixed_link", (-0.062, 0, 0.193))
     w.link(
@@ -297,7 +211,7 @@ def _add_torso_and_head(w: _UrdfWriter) -> None:
     )
 
 
-def _add_arm(w: _UrdfWriter, side: str) -> None:
+def _add_arm(w: UrdfWriter, side: str) -> None:
     reflect = 1 if side == "right" else -1
     origins = arm_joint_origins(reflect)
     mount = (
@@ -330,7 +244,7 @@ def _add_arm(w: _UrdfWriter, side: str) -> None:
     _add_gripper(w, side, tool)
 
 
-def _add_gripper(w: _UrdfWriter, side: str, tool: str) -> None:
+def _add_gripper(w: UrdfWriter, side: str, tool: str) -> None:
     """Palm along the tool x axis, fingers sliding along the tool y axis."""
     palm = f"gripper_{side}_link"
     palm_length = TOOL_TO_GRASP - 0.12
@@ -412,7 +326,7 @@ def _corner_brackets(x: float, y: float, z: float, length: float, width: float):
     ]
 
 
-def _add_hotel(w: _UrdfWriter) -> None:
+def _add_hotel(w: UrdfWriter) -> None:
     """A post-mounted tray with one pocket (floor + four corner L-posts) per slot."""
     length, width = HOTEL_POCKET_SIZE
     shapes = []
@@ -444,7 +358,7 @@ def _add_hotel(w: _UrdfWriter) -> None:
 
 def build_urdf() -> str:
     """URDF text of the whole robot."""
-    writer = _UrdfWriter("tiago_dual_sim")
+    writer = UrdfWriter("tiago_dual_sim")
     _add_base(writer)
     _add_torso_and_head(writer)
     for side in ARM_SIDES:
