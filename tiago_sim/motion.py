@@ -76,6 +76,17 @@ class FailedMotion(Motion):
         return
 
 
+class CompletedMotion(Motion):
+    """Nothing to do (e.g. dock while docked): done and successful from the start."""
+
+    def __init__(self, name: str, message: str) -> None:
+        super().__init__(name)
+        self.finish(True, message=message)
+
+    def tick(self, dt: float) -> None:
+        return
+
+
 class SequenceMotion(Motion):
     """Runs motions made by ``stages`` one after another; each stage is (phase, factory, weight).
 

@@ -23,7 +23,7 @@ from tiago_sim.arm_controller import JointTrajectoryMotion
 from tiago_sim.base_controller import DiffDriveBase, DriveMotion
 from tiago_sim.gripper_controller import Gripper, GripperMotion
 from tiago_sim.kinematics import RobotKinematics
-from tiago_sim.motion import BUSY, FailedMotion, Motion, SequenceMotion
+from tiago_sim.motion import BUSY, CompletedMotion, FailedMotion, Motion, SequenceMotion
 from tiago_sim.perception.camera import CameraIntrinsics, render_rgbd
 from tiago_sim.robot_body import RobotBody
 from tiago_sim.scene import build_scene, plate_bottom_pose
@@ -221,7 +221,9 @@ class Simulation:
         return result
 
     def held_labware(self, arm: str) -> str:
-        return self.grippers[arm].touching()
+        """Plate between that gripper's pads (both touching), or the one attached after a verified grasp."""
+        gripper = self.grippers[arm]
+        return gripper.touching() or gripper.attached_id
 
     # ----------------------------------------------------------------- motions
     def drive_to(self, x: float, y: float, yaw: float, speed: float = rm.MAX_LINEAR_SPEED) -> Motion:
@@ -231,9 +233,7 @@ class Simulation:
 
     def dock(self) -> Motion:
         if self.is_docked():
-            motion = FailedMotion("dock", "", "")
-            motion.success, motion.error_code, motion.message = True, "", "already docked"
-            return motion
+            return CompletedMotion("dock", "already docked")
         approach = self.world.pois[self.world.dock_poi]
         dock = self.world.dock_pose
         beyond = (
@@ -259,6 +259,9 @@ class Simulation:
         return self._start(SequenceMotion("dock", stages, frozenset({"base"})))
 
     def undock(self) -> Motion:
+        """Drive straight ahead off the dock, as far as the dock POI lies in front of the dock."""
+        if not self.is_docked():
+            return CompletedMotion("undock", "not docked")
         x, y, yaw = self.odometry()
         distance = math.dist(
             (self.world.dock_pose.x, self.world.dock_pose.y),
