@@ -7,6 +7,7 @@ Lives on the sim thread.
 
 from __future__ import annotations
 
+import bisect
 from collections.abc import Sequence
 
 import numpy as np
@@ -53,7 +54,7 @@ class JointTrajectoryMotion(Motion):
             durations.append(max(float(np.max(np.abs(b - a) / limits)), min_segment_s))
         # easing the whole path in and out costs about the quintic's peak factor on its ends
         total = sum(durations)
-        self.path_length = np.cumsum([0.0, *durations])
+        self.path_length = [float(v) for v in np.cumsum([0.0, *durations])]
         self.duration = max(total * 1.875 if len(durations) == 1 else total + 2 * min(0.5, total / 2), 1e-3)
         self.phase = "moving"
         self.settle_s = 0.0
@@ -64,9 +65,7 @@ class JointTrajectoryMotion(Motion):
             return self.points[-1], np.zeros(len(self.names))
         s, ds = _smoothstep(t / self.duration)
         along = s * total
-        index = int(
-            np.clip(np.searchsorted(self.path_length, along, side="right") - 1, 0, len(self.points) - 2)
-        )
+        index = min(max(bisect.bisect_right(self.path_length, along) - 1, 0), len(self.points) - 2)
         segment = max(self.path_length[index + 1] - self.path_length[index], 1e-9)
         fraction = (along - self.path_length[index]) / segment
         a, b = self.points[index], self.points[index + 1]

@@ -16,11 +16,15 @@ import numpy as np
 from tiago_sim import robot_model as rm
 from tiago_sim.motion import CANCELED, Motion
 from tiago_sim.robot_body import RobotBody
-from tiago_sim.transforms import wrap_angle
 
 POSITION_TOLERANCE = 0.01  # m
 YAW_TOLERANCE = 0.01  # rad
 HEADING_GAIN = 2.5
+
+
+def wrap_angle(angle: float) -> float:
+    """Angle wrapped to (-pi, pi] (scalar, fast: called every step)."""
+    return math.atan2(math.sin(angle), math.cos(angle))
 
 
 def _ramp(current: float, desired: float, max_change: float) -> float:
@@ -79,8 +83,7 @@ class DiffDriveBase:
         self.idle_steps = 0 if moving else self.idle_steps + 1
         if self.idle_steps > 240:  # stood still for a second: the encoders read nothing, skip the work
             return
-        pose = self.body.base_pose()
-        x, y, yaw = pose[0, 3], pose[1, 3], math.atan2(pose[1, 0], pose[0, 0])
+        x, y, yaw = self.body.base_xy_yaw()
         last_x, last_y, last_yaw = self.last_true
         self.last_true = (x, y, yaw)
         heading = last_yaw + 0.5 * wrap_angle(yaw - last_yaw)

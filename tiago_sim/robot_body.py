@@ -57,6 +57,11 @@ class RobotBody:
         inertial = p.getDynamicsInfo(self.id, -1, physicsClientId=client)
         self.T_com_footprint = tf.invert(tf.from_pose(inertial[3], inertial[4]))
         offset_position, offset_quat = tf.to_pose(self.T_com_footprint)
+        self._footprint_in_com = (
+            float(self.T_com_footprint[0, 3]),
+            float(self.T_com_footprint[1, 3]),
+            float(math.atan2(self.T_com_footprint[1, 0], self.T_com_footprint[0, 0])),
+        )
         self.base_constraint = p.createConstraint(
             self.id,
             -1,
@@ -83,6 +88,14 @@ class RobotBody:
             maxForce=BASE_CONSTRAINT_FORCE,
             physicsClientId=self.client,
         )
+
+    def base_xy_yaw(self) -> tuple[float, float, float]:
+        """Ground-truth planar pose of base_footprint (cheap: for the per-step encoder model)."""
+        (px, py, _), (qx, qy, qz, qw) = p.getBasePositionAndOrientation(self.id, physicsClientId=self.client)
+        yaw = math.atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz))
+        ox, oy, oyaw = self._footprint_in_com
+        c, s = math.cos(yaw), math.sin(yaw)
+        return px + c * ox - s * oy, py + s * ox + c * oy, yaw + oyaw
 
     def base_pose(self) -> np.ndarray:
         """Ground-truth T_world_base (for the controllers' actuator model and success checks only)."""
@@ -134,15 +147,16 @@ class RobotBody:
     def track(self, names: list[str], positions: np.ndarray, velocities: np.ndarray) -> None:
         """Per-step trajectory tracking in one call (targets already timed within the velocity limits)."""
         indices = [self.joint_index[n] for n in names]
-        lows = np.array([self.limits[n][0] for n in names])
-        highs = np.array([self.limits[n][1] for n in names])
-        clipped = np.where(highs > lows, np.clip(positions, lows, highs), positions)
-        self.targets.update(zip(names, clipped.tolist(), strict=True))
+        clipped = []
+        for name, value in zip(names, positions.tolist(), strict=True):
+            lower, upper = self.limits[name][0], self.limits[name][1]
+            clipped.append(min(max(value, lower), upper) if upper > lower else value)
+        self.targets.update(zip(names, clipped, strict=True))
         p.setJointMotorControlArray(
             self.id,
             indices,
             p.POSITION_CONTROL,
-            targetPositions=clipped.tolist(),
+            targetPositions=clipped,
             targetVelocities=np.asarray(velocities, dtype=float).tolist(),
             forces=[self.limits[n][3] for n in names],
             positionGains=[ARM_POSITION_GAIN] * len(names),
