@@ -4,7 +4,7 @@ Why generated: one source of numbers (PAL's public kinematics, see the project n
 PyBullet and pinocchio, and nothing of PAL's meshes is needed. The root link is
 ``base_footprint`` (on the floor, x forward, z up), as on the real robot.
 
-Modelling choices (see also README / WORLD.md):
+Modelling choices (see also README.md, "The world file"):
 - Base: kinematic differential drive. The simulation moves the base through a constraint that
   follows the commanded planar velocity (limited in speed and acceleration) and derives the wheel
   encoder readings from the base's motion. The wheels are fixed links without collision shapes

@@ -1,7 +1,7 @@
 """The lab as data: stations, markers, nests, POIs, labware and the robot start, read from one YAML file.
 
 Why: nothing else hard-codes a station, a POI or a marker id; moving a station is a YAML edit.
-The schema is documented in tiago_sim/WORLD.md. Everything here is frozen and pure (no
+The schema is documented in README.md, "The world file". Everything here is frozen and pure (no
 PyBullet), so any thread may read a World.
 
 Frames: ``table`` frame on the table top centre (x away from the robot's working side, z up);
