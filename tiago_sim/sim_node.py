@@ -177,8 +177,48 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         help="at most this many times real time (default: none)",
     )
     parser.add_argument("--motions", type=Path, default=DEFAULT_MOTIONS_FILE, help="keyframe motions YAML")
+    parser.add_argument("--disturbance-seed", type=int, default=None, help="seed of tiago_sim.disturbances")
+    parser.add_argument("--disturbance-levels", default="", help="DisturbanceLevels JSON")
+    parser.add_argument("--record-dir", type=Path, default=None, help="save camera frames here")
     parser.add_argument("--log-level", default="INFO")
     return parser.parse_args(argv)
+
+
+def make_simulation(simulation_class: Any, world: World, args: argparse.Namespace) -> Any:
+    """The Simulation, built in the true (disturbed) world when a disturbance seed is given."""
+    if args.disturbance_seed is None:
+        sim = simulation_class(world, seed=args.seed)
+    else:
+        from tiago_sim import disturbances
+
+        disturbance = disturbances.draw(world, args.disturbance_seed, _levels(args))
+        sim = simulation_class(
+            disturbances.true_world(world, disturbance),
+            seed=args.disturbance_seed if args.seed is None else args.seed,
+            odometry_noise=disturbance.levels.odometry_noise,
+        )
+        disturbances.apply_to_simulation(sim, disturbance)
+    if args.record_dir is not None:
+        from tiago_sim.run_recorder import RunRecorder
+
+        RunRecorder(sim, world, args.record_dir)
+    return sim
+
+
+def robot_world(world: World, args: argparse.Namespace) -> World:
+    """What the robot's behaviours believe: nominal, with POIs where navigation really stops."""
+    if args.disturbance_seed is None:
+        return world
+    from tiago_sim import disturbances
+
+    return disturbances.believed_world(world, disturbances.draw(world, args.disturbance_seed, _levels(args)))
+
+
+def _levels(args: argparse.Namespace) -> Any:
+    from tiago_sim.disturbances import DisturbanceLevels
+
+    levels_json = args.disturbance_levels
+    return DisturbanceLevels.from_json(levels_json) if levels_json else DisturbanceLevels()
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -188,7 +228,7 @@ def main(argv: list[str] | None = None) -> int:
     from tiago_sim.simulation import Simulation  # heavy import (PyBullet), only in the process that owns it
 
     sim_thread = SimThread(
-        lambda: Simulation(world, seed=args.seed), realtime_factor_cap=args.realtime_factor_cap
+        lambda: make_simulation(Simulation, world, args), realtime_factor_cap=args.realtime_factor_cap
     )
     rclpy.init(args=None, signal_handler_options=SignalHandlerOptions.NO)
     node = rclpy.create_node("tiago_sim")
@@ -204,7 +244,7 @@ def main(argv: list[str] | None = None) -> int:
     signal.signal(signal.SIGTERM, request_stop)
     try:
         sim_thread.start()
-        SimNode(node, world, sim_thread, args.motions)
+        SimNode(node, robot_world(world, args), sim_thread, args.motions)
         executor.add_node(node)
         log.info("sim node ready: world %s, %d stations", world.source, len(world.stations))
         while not stopping and rclpy.ok():
