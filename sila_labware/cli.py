@@ -2,6 +2,7 @@
 
     sila-labware serve --world FILE [--host 127.0.0.1] [--port-base N] [--insecure] [--ca-file PATH]
     sila-labware demo  --world FILE [--json] [same options as serve]
+    sila-labware bluesky-demo --world FILE   (the same robot driven from a Bluesky RunEngine plan)
 
 Exit codes: 0 success, 1 the demo transfer failed or the stack could not start, 2 bad usage.
 """
@@ -36,7 +37,7 @@ def build_parser() -> argparse.ArgumentParser:
         prog="sila-labware", description="A TIAGo++ mobile manipulator as a SiLA 2 labware-transfer device."
     )
     subcommands = parser.add_subparsers(
-        dest="command", required=True, metavar="{serve,demo}", parser_class=_Parser
+        dest="command", required=True, metavar="{serve,demo,bluesky-demo}", parser_class=_Parser
     )
 
     def add_stack_options(sub: argparse.ArgumentParser) -> None:
@@ -85,6 +86,24 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument(
         "--json", action="store_true", help="print one JSON object with the outcome and timings"
     )
+    bluesky = subcommands.add_parser(
+        "bluesky-demo",
+        help="run the robot side and a Bluesky plan: pickup, place, measure, return the plate",
+    )
+    bluesky.add_argument(
+        "--world", type=Path, default=DEFAULT_WORLD, help="world YAML (default: the bundled lab)"
+    )
+    bluesky.add_argument(
+        "--domain-id", type=int, default=None, help="ROS domain (default: $ROS_DOMAIN_ID or random)"
+    )
+    bluesky.add_argument(
+        "--log-dir", type=Path, default=None, help="write the robot side's output to files here"
+    )
+    bluesky.add_argument(
+        "--ready-timeout", type=float, default=180.0, help="seconds to wait for the robot side"
+    )
+    bluesky.add_argument("--verbose", action="store_true", help="log at INFO level")
+    bluesky.set_defaults(port_base=50052)
     return parser
 
 
@@ -209,6 +228,25 @@ def demo(args: argparse.Namespace) -> int:
     return 0 if report.success else 1
 
 
+def bluesky_demo(args: argparse.Namespace) -> int:
+    """Robot side only (no SiLA): the beamline paper's plan on a RunEngine against the simulation."""
+    from ros_bridge.bluesky.demo import run_bluesky_demo
+    from sila_labware.deployment import choose_domain_id, join_ros_domain, start_robot_side
+    from sila_labware.processes import ProcessGroup, ros_environment
+
+    domain_id = choose_domain_id(args.domain_id)
+    join_ros_domain(domain_id)
+    with ProcessGroup(ros_environment(domain_id), args.log_dir) as children:
+        start_robot_side(children, args.world)
+        sys.stderr.write(f"robot side started (ROS domain {domain_id}); running the Bluesky plan\n")
+        return run_bluesky_demo(
+            args.world, domain_id=domain_id, ready_timeout_s=args.ready_timeout, progress_bar=True
+        )
+
+
+COMMANDS = {"serve": serve, "demo": demo, "bluesky-demo": bluesky_demo}
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -220,7 +258,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not args.verbose:
         # sila2 logs every defined error a client receives as a server-side traceback.
         logging.getLogger("sila2").setLevel(logging.CRITICAL)
-    return serve(args) if args.command == "serve" else demo(args)
+    if args.command == "bluesky-demo":
+        # bluesky's own loggers report every state change at INFO
+        logging.getLogger("bluesky").setLevel(logging.INFO if args.verbose else logging.WARNING)
+    return COMMANDS[args.command](args)
 
 
 if __name__ == "__main__":

@@ -15,7 +15,7 @@ import os
 import random
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -72,6 +72,22 @@ def choose_domain_id(requested: int | None) -> int:
     return random.SystemRandom().randint(1, 101)
 
 
+def start_robot_side(children: ProcessGroup, world: Path, extra_sim_arguments: Sequence[str] = ()) -> None:
+    """Start the robot side's ROS nodes (simulation node, sequencer) as children."""
+    for name, module in ROBOT_SIDE_MODULES:
+        arguments = ["--world", str(world)]
+        if name == "sim_node":
+            arguments += list(extra_sim_arguments)
+        children.start_python_module(name, module, arguments)
+
+
+def join_ros_domain(domain_id: int) -> None:
+    """Put this process's own ROS participants (the bridge) into the deployment's domain."""
+    os.environ.update(
+        {key: value for key, value in ros_environment(domain_id).items() if key.startswith(("ROS_", "RMW_"))}
+    )
+
+
 class Deployment:
     """Start and stop the whole stack; reach its parts (link, robot, servers) while it runs."""
 
@@ -97,21 +113,10 @@ class Deployment:
             raise
 
     def _start_robot_side(self) -> None:
-        world = str(self.options.world)
-        for name, module in ROBOT_SIDE_MODULES:
-            arguments = ["--world", world]
-            if name == "sim_node":
-                arguments += self.options.extra_sim_arguments
-            self.children.start_python_module(name, module, arguments)
+        start_robot_side(self.children, self.options.world, self.options.extra_sim_arguments)
 
     def _start_bridge(self, should_stop: Callable[[], bool]) -> None:
-        os.environ.update(
-            {
-                key: value
-                for key, value in ros_environment(self.domain_id).items()
-                if key.startswith(("ROS_", "RMW_"))
-            }
-        )
+        join_ros_domain(self.domain_id)
         self.runtime = RosRuntime("sila_labware_bridge", domain_id=self.domain_id).start()
         self.link = RobotLink(self.runtime)
         deadline = time.monotonic() + self.options.ready_timeout_s
