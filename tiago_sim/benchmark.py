@@ -4,9 +4,10 @@
 
 Starts sim_node and sequencer as child processes (own ROS domain unless ROS_DOMAIN_ID is set),
 runs GetLabware at the source and PutLabware at the destination, and prints simulated and wall
-time, the real-time factor, wall time per phase (from the task feedback), the placement error
-and the marker pose error against ground truth. Ground truth (the world file and the
-/check_placement service) is used here only to measure.
+time, the real-time factor, sim and wall time per task phase (phase changes from the task
+feedback, sim time from the robot goals' spans in the sim node's log), the placement error and the marker
+pose error against ground truth, with the targets of issue 5 beside them. Ground truth (the
+world file and the /check_placement service) is used here only to measure.
 """
 
 from __future__ import annotations
@@ -15,13 +16,33 @@ import argparse
 import math
 import os
 import random
+import re
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from collections import defaultdict
 from pathlib import Path
 from typing import Any
+
+# Targets of issue 5 (printed beside the figures; tests never assert time).
+TARGET_SIM_S = 60.0
+TARGET_REALTIME_FACTOR = 10.0
+
+
+_NO_GOAL = {"starting", "done", "result"}  # task phases during which no robot goal runs
+_GOAL_LINE = re.compile(r"tiago_sim\.ros_actions: (/\w+) \S+: sim ([\d.]+) \.\. ([\d.]+) s")
+
+
+def _goal_spans(log_path: Path) -> list[tuple[str, float, float]]:
+    """(action, sim start, sim end) of every robot goal, in order, from the sim node's log."""
+    spans = []
+    for line in log_path.read_text().splitlines():
+        match = _GOAL_LINE.search(line)
+        if match:
+            spans.append((match[1], float(match[2]), float(match[3])))
+    return spans
 
 
 def _start(module: str, args: list[str], log_dir: Path) -> subprocess.Popen:
@@ -76,10 +97,17 @@ def main(argv: list[str] | None = None) -> int:
     clock: dict[str, float] = {}
     qos = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
     truth: dict[str, Any] = {}
-    node.create_subscription(Pose2D, "/ground_truth/base_pose", lambda m: truth.__setitem__("now", m), qos)
-    node.create_subscription(
-        Clock, "/clock", lambda m: clock.__setitem__("t", m.clock.sec + m.clock.nanosec * 1e-9), qos
-    )
+    truth_wanted = threading.Event()
+
+    def on_truth(message: Any) -> None:
+        truth["now"] = message
+        truth_wanted.clear()
+
+    def on_clock(message: Any) -> None:
+        clock["t"] = message.clock.sec + message.clock.nanosec * 1e-9
+
+    node.create_subscription(Pose2D, "/ground_truth/base_pose", on_truth, qos)
+    node.create_subscription(Clock, "/clock", on_clock, qos)
 
     def wait(future: Any, timeout_s: float) -> Any:
         executor.spin_until_future_complete(future, timeout_sec=timeout_s)
@@ -95,36 +123,49 @@ def main(argv: list[str] | None = None) -> int:
             if time.monotonic() > end:
                 raise TimeoutError("robot did not come up")
             executor.spin_once(timeout_sec=0.1)
-        phase_wall: dict[str, float] = defaultdict(float)
-        sim_start, wall_start = clock["t"], time.monotonic()
+        boundaries: list[tuple[str, float]] = []  # (phase, wall time it started)
+        wall_start = time.monotonic()
         for kind, station in ((GetLabware, args.source), (PutLabware, args.destination)):
             goal = kind.Goal(
                 handover_position=station, sub_position=1, internal_position=1, labware_id=plate.labware_id
             )
-            last = {"phase": "", "t": time.monotonic()}
 
-            def on_feedback(message: Any, last: dict = last, task: str = kind.__name__) -> None:
-                now = time.monotonic()
-                if last["phase"]:
-                    phase_wall[f"{task}: {last['phase'].split(':')[0]}"] += now - last["t"]
-                last["phase"], last["t"] = message.feedback.phase, now
+            def on_feedback(message: Any, task: str = kind.__name__) -> None:
+                phase = f"{task}: {message.feedback.phase.split(':')[0]}"
+                if not boundaries or boundaries[-1][0] != phase:
+                    boundaries.append((phase, time.monotonic()))
 
             handle = wait(clients[kind].send_goal_async(goal, feedback_callback=on_feedback), 30)
             result = wait(handle.get_result_async(), 600).result
+            boundaries.append((f"{kind.__name__}: result", time.monotonic()))
             print(f"{kind.__name__} {station}: success={result.success} {result.error_code} {result.message}")
             if not result.success:
                 return 1
-            executor.spin_once(timeout_sec=0.6)
-            truth[station] = truth.get("now")  # the base stood here through the manipulation
-        executor.spin_once(timeout_sec=0.2)
-        sim_s, wall_s = clock["t"] - sim_start, time.monotonic() - wall_start
+            truth_wanted.set()
+            while truth_wanted.is_set():  # the base stood here through the manipulation
+                executor.spin_once(timeout_sec=0.1)
+            truth[station] = truth.get("now")
+        wall_end = boundaries[-1][1]
+        wall_s = wall_end - wall_start
+        goals = _goal_spans(log_dir / "sim_node.log")
+        phases = [(phase, t0) for phase, t0 in boundaries if phase.split(": ", 1)[1] not in _NO_GOAL]
+        if len(goals) != len(phases):
+            print(f"warning: {len(goals)} robot goals, {len(phases)} task phases: phase sim times are off")
+        sim_s = goals[-1][2] - goals[0][1] if goals else math.nan
         check_client = node.create_client(CheckPlacement, "/check_placement")
         check = wait(check_client.call_async(CheckPlacement.Request(
             labware_id=plate.labware_id, station=args.destination, sub_position=1)), 30)  # fmt: skip
-        print(f"simulated {sim_s:.1f} s, wall {wall_s:.1f} s, real-time factor {sim_s / wall_s:.1f}")
-        print("wall time per phase:")
-        for phase, seconds in phase_wall.items():
-            print(f"  {phase:<32} {seconds:6.2f} s")
+        print(f"simulated {sim_s:.1f} s (target <= {TARGET_SIM_S:.0f} s), wall {wall_s:.1f} s, "
+              f"real-time factor {sim_s / wall_s:.1f} (target >= {TARGET_REALTIME_FACTOR:.0f})")  # fmt: skip
+        wall_ends = {t0: t1 for (_, t0), (_, t1) in zip(boundaries[:-1], boundaries[1:], strict=True)}
+        per_phase: dict[str, list[float]] = defaultdict(lambda: [0.0, 0.0])
+        for index, ((phase, started), (_, sim_begin, sim_end)) in enumerate(zip(phases, goals, strict=False)):
+            next_begin = goals[index + 1][1] if index + 1 < len(goals) else sim_end
+            per_phase[phase][0] += next_begin - sim_begin  # the goal and the gap up to the next one
+            per_phase[phase][1] += wall_ends[started] - started
+        print(f"  {'phase':<32} {'sim s':>7} {'wall s':>7}")
+        for phase, (phase_sim, phase_wall) in per_phase.items():
+            print(f"  {phase:<32} {phase_sim:7.2f} {phase_wall:7.2f}")
         print(f"placement: in_nest={check.in_nest} error {check.position_error_m * 1000:.2f} mm, "
               f"yaw {math.degrees(check.yaw_error_rad):.2f} deg")  # fmt: skip
         _marker_errors(log_dir / "sim_node.log", world, truth, np, tf)

@@ -105,6 +105,7 @@ class RobotActionServers:
             run = ActionRun(goal_handle, action_type.Feedback, self.sim_thread, feedback_hz=self.feedback_hz)
             result = action_type.Result()
             acquired = False
+            sim_started = self.sim_thread.sim_time
             try:
                 self.slot.acquire(name)
                 acquired = True
@@ -129,6 +130,11 @@ class RobotActionServers:
                 if acquired:
                     self.activity.state = ""
                     self.slot.release()
+                # one line per goal with its simulated span (tiago_sim.benchmark times phases by it)
+                log.info(
+                    "%s %s: sim %.3f .. %.3f s",
+                    name, result.error_code or "done", sim_started, self.sim_thread.sim_time,
+                )  # fmt: skip
             return result
 
         return callback

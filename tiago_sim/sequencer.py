@@ -225,6 +225,7 @@ class Sequencer:
                     )
                     if goal_handle.is_cancel_requested:
                         raise StepFailed(ErrorCodes.CANCELED, f"canceled before {step.describe()}")
+                    run.publish()  # a new phase is news: clients see it at once, not at the next tick
                     await self._run_step(run, step)
                 run.index, run.phase = len(plan), "done"
                 run.publish()  # the last word is progress 1.0
