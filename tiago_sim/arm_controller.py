@@ -19,18 +19,42 @@ SETTLE_TOLERANCE = 0.02  # rad (m for the torso): goal tolerance, as a joint tra
 SETTLE_TIMEOUT_S = 1.5
 
 
-def _smoothstep(s: float) -> tuple[float, float]:
-    """Quintic blend (value, derivative) on [0, 1]: zero velocity and acceleration at both ends."""
-    s = min(max(s, 0.0), 1.0)
-    return s**3 * (10 - 15 * s + 6 * s * s), 30 * s * s * (1 - s) ** 2
+RAMP_S = 0.3  # s from rest to a joint's full speed (and back) at speed scale 1
+
+
+def _trapezoid(t: float, total: float, ramp: float) -> tuple[float, float]:
+    """Distance along a path and speed fraction at time t of a trapezoidal speed profile.
+
+    The path takes ``total`` seconds at full speed; the speed ramps linearly up and down over
+    ``ramp`` seconds (a triangle when the path is shorter than that). Why not a quintic blend:
+    its peak speed is 1.875x its mean, so timing it within the velocity limits nearly doubles
+    every move; a trapezoid cruises at the limit.
+    """
+    accel = 1.0 / ramp
+    t_accel = min(ramp, (total * ramp) ** 0.5)
+    cruise_end = total / (accel * t_accel)  # time at which deceleration starts
+    duration = cruise_end + t_accel
+    t = min(max(t, 0.0), duration)
+    peak = accel * t_accel
+    if t < t_accel:
+        return 0.5 * accel * t * t, accel * t
+    if t < cruise_end:
+        return 0.5 * accel * t_accel * t_accel + peak * (t - t_accel), peak
+    left = duration - t
+    return total - 0.5 * accel * left * left, accel * left
+
+
+def _trapezoid_duration(total: float, ramp: float) -> float:
+    t_accel = min(ramp, (total * ramp) ** 0.5)
+    return total / t_accel * ramp + t_accel
 
 
 class JointTrajectoryMotion(Motion):
-    """Through ``waypoints`` (dicts of joint targets); smooth start and stop, linear in between.
+    """Through ``waypoints`` (dicts of joint targets): linear segments under one speed profile.
 
-    A single waypoint gets a quintic profile (peak speed 1.875x the mean) timed so no joint
-    exceeds ``speed_scale`` times its limit; several waypoints are linear segments timed the same
-    way and eased in and out as a whole.
+    Segments are timed so no joint exceeds ``speed_scale`` times its limit (or take at least
+    ``min_segment_s``); the whole path follows a trapezoidal speed profile, starting and ending at
+    rest, ramping over RAMP_S / speed_scale.
     """
 
     def __init__(
@@ -48,14 +72,14 @@ class JointTrajectoryMotion(Motion):
         start = body.joint_positions()
         self.points = [np.array([start[n] for n in self.names])]
         self.points += [np.array([wp[n] for n in self.names]) for wp in waypoints]
-        limits = np.array([body.limits[n][2] for n in self.names]) * max(min(speed_scale, 1.0), 0.05)
+        scale = max(min(speed_scale, 1.0), 0.05)
+        limits = np.array([body.limits[n][2] for n in self.names]) * scale
         durations = []
         for a, b in zip(self.points[:-1], self.points[1:], strict=True):
             durations.append(max(float(np.max(np.abs(b - a) / limits)), min_segment_s))
-        # easing the whole path in and out costs about the quintic's peak factor on its ends
-        total = sum(durations)
         self.path_length = [float(v) for v in np.cumsum([0.0, *durations])]
-        self.duration = max(total * 1.875 if len(durations) == 1 else total + 2 * min(0.5, total / 2), 1e-3)
+        self.ramp_s = RAMP_S / scale
+        self.duration = max(_trapezoid_duration(self.path_length[-1], self.ramp_s), 1e-3)
         self.phase = "moving"
         self.settle_s = 0.0
 
@@ -63,14 +87,12 @@ class JointTrajectoryMotion(Motion):
         total = self.path_length[-1]
         if total <= 0.0:
             return self.points[-1], np.zeros(len(self.names))
-        s, ds = _smoothstep(t / self.duration)
-        along = s * total
+        along, speed = _trapezoid(t, total, self.ramp_s)
         index = min(max(bisect.bisect_right(self.path_length, along) - 1, 0), len(self.points) - 2)
         segment = max(self.path_length[index + 1] - self.path_length[index], 1e-9)
-        fraction = (along - self.path_length[index]) / segment
+        fraction = min((along - self.path_length[index]) / segment, 1.0)
         a, b = self.points[index], self.points[index + 1]
-        velocity = (b - a) / segment * ds * total / self.duration
-        return a + (b - a) * fraction, velocity
+        return a + (b - a) * fraction, (b - a) / segment * speed
 
     def tick(self, dt: float) -> None:
         if self.cancel_requested:

@@ -310,6 +310,13 @@ class Simulation:
             jump = max(
                 (abs(result.joint_positions[n] - seed[n]) for n in result.joint_positions), default=0.0
             )
+            if straight_line and (not result.success or jump > MAX_WAYPOINT_JUMP):
+                # near a joint limit the seeded solve can stall: creep there in small, seeded steps
+                T_previous = waypoints[index - 1] if index else T_start
+                result = self._creep(arm, T_previous, T_waypoint, seed) or result
+                jump = max(
+                    (abs(result.joint_positions[n] - seed[n]) for n in result.joint_positions), default=0.0
+                )
             if not result.success or (straight_line and jump > MAX_WAYPOINT_JUMP):
                 why = "unreachable" if not result.success else f"joint jump {jump:.2f} rad"
                 return FailedMotion("move_tool", "IK_FAILED", f"waypoint {index + 1}/{len(waypoints)} {why}")
@@ -321,6 +328,17 @@ class Simulation:
             self.robot, solutions, 1.0, name="move_tool", min_segment_s=segment_s, resources=resources
         )
         return self._start(motion)
+
+    def _creep(self, arm: str, T_from: np.ndarray, T_to: np.ndarray, seed: dict[str, float]):
+        """IK for T_to reached from T_from in seeded sub-steps (no random restarts), or None."""
+        here = dict(seed)
+        result = None
+        for T_sub in _straight_path(T_from, T_to, step=STRAIGHT_STEP / 5):
+            result = self.kinematics.inverse(arm, T_sub, here, use_torso=True, restarts=0, max_iterations=400)
+            if not result.success:
+                return None
+            here.update(result.joint_positions)
+        return result
 
     def gripper(self, arm: str, close: bool) -> Motion:
         if arm not in rm.ARM_SIDES:
@@ -364,11 +382,11 @@ class Simulation:
         return "unknown"
 
 
-def _straight_path(T_start: np.ndarray, T_goal: np.ndarray) -> list[np.ndarray]:
+def _straight_path(T_start: np.ndarray, T_goal: np.ndarray, step: float = STRAIGHT_STEP) -> list[np.ndarray]:
     """Poses along the straight line (and the shortest rotation) from start to goal, goal last."""
     distance = float(np.linalg.norm(T_goal[:3, 3] - T_start[:3, 3]))
     angle = tf.rotation_angle(T_start[:3, :3], T_goal[:3, :3])
-    count = max(1, math.ceil(distance / STRAIGHT_STEP), math.ceil(angle / 0.05))
+    count = max(1, math.ceil(distance / step), math.ceil(angle / (5 * step)))
     relative = T_start[:3, :3].T @ T_goal[:3, :3]
     axis_angle = _log_rotation(relative)
     poses = []
