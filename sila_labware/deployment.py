@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import logging
 import os
-import random
 import threading
 import time
 from collections.abc import Callable, Sequence
@@ -21,6 +20,7 @@ from pathlib import Path
 
 from sila2.server import SilaServer
 
+from ros_bridge.domain import reserve_domain_id
 from ros_bridge.errors import BridgeError
 from ros_bridge.robot_link import RobotLink
 from ros_bridge.runtime import RosRuntime
@@ -64,12 +64,12 @@ class ServedServer:
 
 
 def choose_domain_id(requested: int | None) -> int:
-    """The requested id, else ROS_DOMAIN_ID from the environment, else a random one (1..101)."""
+    """The requested id, else ROS_DOMAIN_ID from the environment, else one reserved for this process."""
     if requested is not None:
         return requested
     if os.environ.get("ROS_DOMAIN_ID", "").isdigit():
         return int(os.environ["ROS_DOMAIN_ID"])
-    return random.SystemRandom().randint(1, 101)
+    return reserve_domain_id()
 
 
 def start_robot_side(children: ProcessGroup, world: Path, extra_sim_arguments: Sequence[str] = ()) -> None:

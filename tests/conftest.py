@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import os
-import random
 
-# Set before anything imports rclpy, so every node of this run (and every child process,
-# which inherits the environment) lives in a domain no parallel run uses.
-os.environ["ROS_DOMAIN_ID"] = str(random.SystemRandom().randint(1, 101))
+from ros_bridge.domain import reserve_domain_id
+
+# Set before anything imports rclpy, so every node of this run (and every child process, which
+# inherits the environment) lives in a domain that no other run on this machine holds.
+os.environ["ROS_DOMAIN_ID"] = str(reserve_domain_id())
 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
 os.environ.setdefault("RMW_IMPLEMENTATION", "rmw_fastrtps_cpp")
