@@ -1,7 +1,8 @@
 """Command line entry point `sila-labware`: serve the robot and its stations over SiLA, or run the demo.
 
     sila-labware serve --world FILE [--host 127.0.0.1] [--port-base N] [--insecure] [--ca-file PATH]
-    sila-labware demo  --world FILE [--json] [same options as serve]
+    sila-labware demo  --world FILE [--json] [--record DIR] [same options as serve]
+    sila-labware bench --trials N --seed S [--json] [--report DIR] [--replay SEED] [levels] (bench_cli)
     sila-labware bluesky-demo --world FILE   (the same robot driven from a Bluesky RunEngine plan)
 
 Exit codes: 0 success, 1 the demo transfer failed or the stack could not start, 2 bad usage.
@@ -20,6 +21,14 @@ from collections.abc import Sequence
 from pathlib import Path
 from types import FrameType
 
+from sila_labware.bench_cli import (
+    add_bench_arguments,
+    bench_command,
+    temporary_ca_file,
+    validate_bench,
+    write_recorded_pictures,
+)
+
 logger = logging.getLogger("sila_labware")
 
 DEFAULT_WORLD = Path(__file__).resolve().parent.parent / "tiago_sim" / "worlds" / "default.yaml"
@@ -37,7 +46,7 @@ def build_parser() -> argparse.ArgumentParser:
         prog="sila-labware", description="A TIAGo++ mobile manipulator as a SiLA 2 labware-transfer device."
     )
     subcommands = parser.add_subparsers(
-        dest="command", required=True, metavar="{serve,demo,bluesky-demo}", parser_class=_Parser
+        dest="command", required=True, metavar="{serve,demo,bluesky-demo,bench}", parser_class=_Parser
     )
 
     def add_stack_options(sub: argparse.ArgumentParser) -> None:
@@ -86,6 +95,12 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument(
         "--json", action="store_true", help="print one JSON object with the outcome and timings"
     )
+    demo.add_argument(
+        "--record", type=Path, default=None, metavar="DIR", help="write pictures of the run here"
+    )
+    bench = subcommands.add_parser("bench", help="repeat the demo transfer under seeded disturbances")
+    add_stack_options(bench)
+    add_bench_arguments(bench)
     bluesky = subcommands.add_parser(
         "bluesky-demo",
         help="run the robot side and a Bluesky plan: pickup, place, measure, return the plate",
@@ -114,6 +129,8 @@ def _validate(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None
         parser.error(f"--port-base {args.port_base} is not a usable port")
     if args.domain_id is not None and not 0 <= args.domain_id <= 232:
         parser.error(f"--domain-id {args.domain_id} is outside 0..232")
+    if args.command == "bench":
+        validate_bench(parser, args)
 
 
 class _StopRequest:
@@ -149,13 +166,21 @@ def _deployment_from(args: argparse.Namespace):
             domain_id=args.domain_id,
             ready_timeout_s=args.ready_timeout,
             log_dir=args.log_dir,
+            extra_sim_arguments=_record_arguments(args),
         )
     )
+
+
+def _record_arguments(args: argparse.Namespace) -> list[str]:
+    record = getattr(args, "record", None)
+    return [] if record is None else ["--record-dir", str(record / "frames")]
 
 
 def _ca_file(args: argparse.Namespace) -> Path:
     if args.ca_file is not None:
         return args.ca_file
+    if args.command == "bench":
+        return temporary_ca_file()
     if args.command == "demo":
         return Path(tempfile.mkdtemp(prefix="sila-labware-demo-")) / "ca.pem"
     return Path("sila-labware-ca.pem")
@@ -216,6 +241,8 @@ def demo(args: argparse.Namespace) -> int:
         report = run_demo(deployment, progress_stream=sys.stderr)
     finally:
         deployment.stop()
+    if args.record is not None:
+        write_recorded_pictures(args.record)
     if args.json:
         sys.stdout.write(json.dumps(report.as_json_object()) + "\n")
     else:
@@ -244,7 +271,11 @@ def bluesky_demo(args: argparse.Namespace) -> int:
         )
 
 
-COMMANDS = {"serve": serve, "demo": demo, "bluesky-demo": bluesky_demo}
+def _bench(args: argparse.Namespace) -> int:
+    return bench_command(args, _deployment_from(args).options)
+
+
+COMMANDS = {"serve": serve, "demo": demo, "bluesky-demo": bluesky_demo, "bench": _bench}
 
 
 def main(argv: Sequence[str] | None = None) -> int:
