@@ -29,7 +29,7 @@ from tiago_sim.action_run import ActionAbort, ActionRun
 from tiago_sim.kinematics import RobotKinematics
 from tiago_sim.motion_library import HotelGrasp
 from tiago_sim.perception.aruco import detect_marker
-from tiago_sim.robot_behaviours import RobotBehaviours
+from tiago_sim.robot_behaviours import TOOL_SPEED_FREE, TOOL_SPEED_INTO_POCKET, RobotBehaviours
 from tiago_sim.transforms import to_pose
 from tiago_sim.world import World
 
@@ -142,8 +142,10 @@ class MarkerMotionBehaviour:
         seed = run.sim(lambda sim: dict(sim.joint_positions()))
         T_base_grasp = sighting.T_base_marker @ T_marker_site @ self.grasp.T_slot_grasp(approach=False)
         T_base_target = self.behaviours.grasp_twin(arm, T_base_grasp, seed)
+        in_nest = goal.target == "site"  # slow only where the plate enters or leaves the nest
+        speed = TOOL_SPEED_INTO_POCKET if in_nest else TOOL_SPEED_FREE
         try:
-            run.run_motion(lambda sim: sim.move_tool(arm, T_base_target, True), span=(0.1, 1.0))
+            run.run_motion(lambda sim: sim.move_tool(arm, T_base_target, True, speed), span=(0.1, 1.0))
         except ActionAbort as abort:
             abort.extra = {"marker_in_base": marker_in_base}
             raise

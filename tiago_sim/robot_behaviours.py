@@ -26,6 +26,11 @@ from tiago_sim.transforms import make_transform
 
 log = logging.getLogger(__name__)
 
+# Straight tool moves (m/s along the line; joint limits cap them too): slow where the plate enters a
+# nest or hotel pocket, where chamfers guide it; faster in free space (approach, lift, carry).
+TOOL_SPEED_INTO_POCKET = 0.08
+TOOL_SPEED_FREE = 0.15
+
 # Half-turn about the grasp x axis: the same top-down grasp with the fingers swapped.
 FLIP_ABOUT_APPROACH = make_transform(rotation=np.diag([1.0, -1.0, -1.0]))
 
@@ -166,18 +171,19 @@ class RobotBehaviours:
         span: tuple[float, float],
         *,
         free: bool = False,
+        tool_speed: float = TOOL_SPEED_FREE,
     ) -> None:
         """Straight tool move to a top-down grasp pose; with `free`, a joint-space move when no
         straight line exists (e.g. from the folded Home pose, where nothing is in the way)."""
         seed = run.sim(lambda sim: dict(sim.joint_positions()))
         target = self.grasp_twin(arm, T_base_grasp, seed)
         try:
-            run.run_motion(lambda sim: sim.move_tool(arm, target, True), span=span)
+            run.run_motion(lambda sim: sim.move_tool(arm, target, True, tool_speed), span=span)
         except ActionAbort as abort:
             if not free or abort.code != ErrorCodes.IK_FAILED:
                 raise
             log.info("no straight path to %s: moving in joint space", np.round(target[:3, 3], 3))
-            run.run_motion(lambda sim: sim.move_tool(arm, target, False), span=span)
+            run.run_motion(lambda sim: sim.move_tool(arm, target, False, tool_speed), span=span)
 
     def _over_slot(self, arm: str, joints: dict[str, float], slot: int, radius_m: float) -> bool:
         tool = self.tool_pose(arm, joints)[:3, 3]
@@ -190,14 +196,18 @@ class RobotBehaviours:
             if self._over_slot(arm, joints, slot, 0.05):
                 T_carry = self.tool_pose(arm, joints)
                 T_carry[2, 3] = self.hotel_grasp_pose(slot, True)[2, 3] + self.motions.hotel.carry_height_m
-                run.run_motion(lambda sim, target=T_carry: sim.move_tool(arm, target, True), span=(0.0, 0.3))
+                run.run_motion(
+                    lambda sim, target=T_carry: sim.move_tool(arm, target, True, TOOL_SPEED_FREE),
+                    span=(0.0, 0.3),
+                )
                 return 0.3
         return 0.0
 
     def _hotel_motion(self, run: ActionRun, arm: str, name: str, slot: int) -> None:
         T_approach = self.hotel_grasp_pose(slot, approach=True)
         if name == "Nest":  # straight down into the pocket (back up: NestApproach)
-            self._tool_move(run, arm, self.hotel_grasp_pose(slot, approach=False), (0.0, 1.0))
+            T_nest = self.hotel_grasp_pose(slot, approach=False)
+            self._tool_move(run, arm, T_nest, (0.0, 1.0), tool_speed=TOOL_SPEED_INTO_POCKET)
             return
         joints = run.sim(lambda sim: dict(sim.joint_positions()))
         if self._over_slot(arm, joints, slot, 0.03):  # straight up or down to the approach pose

@@ -40,7 +40,7 @@ SOLVER_ITERATIONS = 20
 DOCK_SENSOR_RANGE = 0.004  # m: the charging contacts close within this distance
 DOCK_SPEED = 0.05  # m/s backing onto the dock: stops within 3 mm once the contacts close
 DOCK_OVERTRAVEL = 0.08  # m: the reverse drive aims this far past the docked pose, contact ends it
-TOOL_SPEED = 0.08  # m/s along straight tool moves
+TOOL_SPEED = 0.08  # m/s along straight tool moves unless the caller asks otherwise
 STRAIGHT_STEP = 0.01  # m between IK waypoints
 MAX_WAYPOINT_JUMP = 0.25  # rad between consecutive IK waypoints
 NEST_SENSOR_RANGE = 0.02  # m: presence sensor sees a plate whose centre is this close to the site
@@ -292,8 +292,13 @@ class Simulation:
                 return f"gripper_{side}"
         return name.split("_")[0]  # torso, head, wheel
 
-    def move_tool(self, arm: str, T_base_grasp: np.ndarray, straight_line: bool = True) -> Motion:
-        """Grasping frame of ``arm`` to a pose in base_footprint, via IK waypoints when straight."""
+    def move_tool(
+        self, arm: str, T_base_grasp: np.ndarray, straight_line: bool = True, tool_speed: float = TOOL_SPEED
+    ) -> Motion:
+        """Grasping frame of ``arm`` to a pose in base_footprint, via IK waypoints when straight.
+
+        ``tool_speed`` (m/s) caps the speed along a straight line; the joint limits cap it too.
+        """
         if arm not in rm.ARM_SIDES:
             return FailedMotion("move_tool", "BAD_GOAL", f"unknown arm {arm!r}")
         current = self.joint_positions()
@@ -322,7 +327,7 @@ class Simulation:
                 return FailedMotion("move_tool", "IK_FAILED", f"waypoint {index + 1}/{len(waypoints)} {why}")
             solutions.append(result.joint_positions)
             seed.update(result.joint_positions)
-        segment_s = STRAIGHT_STEP / TOOL_SPEED if straight_line else 0.0
+        segment_s = STRAIGHT_STEP / max(tool_speed, 1e-3) if straight_line else 0.0
         resources = frozenset({f"arm_{arm}", "torso"})
         motion = JointTrajectoryMotion(
             self.robot, solutions, 1.0, name="move_tool", min_segment_s=segment_s, resources=resources
