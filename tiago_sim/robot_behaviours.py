@@ -29,7 +29,7 @@ log = logging.getLogger(__name__)
 # Straight tool moves (m/s along the line; joint limits cap them too): slow where the plate enters a
 # nest or hotel pocket, where chamfers guide it; faster in free space (approach, lift, carry).
 TOOL_SPEED_INTO_POCKET = 0.08
-TOOL_SPEED_FREE = 0.15
+TOOL_SPEED_FREE = 0.08  # 0.15 lost the plate on the return trip of test_ros_transfer (see report)
 
 # Half-turn about the grasp x axis: the same top-down grasp with the fingers swapped.
 FLIP_ABOUT_APPROACH = make_transform(rotation=np.diag([1.0, -1.0, -1.0]))
