@@ -197,6 +197,13 @@ class RobotLink:
         """Call `listener(status)` on every change of /robot_state (on the ROS thread)."""
         self._robot_state.add_listener(lambda message: listener(robot_status_from_message(message)))
 
+    def mark_robot_side_lost(self, reason: str) -> None:
+        """Show locally that the robot side is gone: state "error" with `reason`, nothing observed
+        aboard (a dead robot side reports nothing). Listeners see it like a received message;
+        the next real /robot_state replaces it. Used by the deployment's supervisor."""
+        message = RobotState(state=RobotState.STATE_ERROR, detail=reason)
+        self.runtime.call(lambda: self._robot_state._on_message(message))
+
     def on_nest_occupancies(self, listener: Callable[[tuple[NestOccupancy, ...]], None]) -> None:
         """Call `listener(nests)` on every change of /station_states (on the ROS thread)."""
         self._station_states.add_listener(lambda message: listener(nest_occupancies_from_message(message)))

@@ -75,6 +75,11 @@ def bench_command(args: argparse.Namespace, stack: DeploymentOptions) -> int:
     """Run the campaign (or one replayed trial), print the table or JSON, write the report."""
     from sila_labware.bench_report import write_charts, write_run_pictures
 
+    if not args.verbose:
+        # sila2 logs every failed command as a server-side traceback under loggers named after the
+        # feature or command; the bench's own log (failures with their seeds) stays visible.
+        logging.getLogger().setLevel(logging.CRITICAL)
+        logging.getLogger("sila_labware").setLevel(logging.WARNING)
     levels = level_values(args)
     first_seed, trials = (args.replay, 1) if args.replay is not None else (args.seed, args.trials)
     frames_dir = args.report / "frames" if args.report is not None else None

@@ -214,7 +214,7 @@ def serve(args: argparse.Namespace) -> int:
         sys.stdout.write("serving; Ctrl-C stops\n")
         sys.stdout.flush()
         while not stop.event.wait(0.5):
-            deployment.children.check_running()
+            deployment.check_healthy()
         return 0
     except Exception as error:  # noqa: BLE001
         sys.stderr.write(f"sila-labware: {error}\n")

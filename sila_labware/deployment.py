@@ -30,6 +30,7 @@ from sila_labware.robot_controller import RobotController
 from sila_labware.robot_server.server import Server as RobotServer
 from sila_labware.station_controller import StationController
 from sila_labware.station_server.server import Server as StationServer
+from sila_labware.supervisor import RobotSideSupervisor
 from sila_labware.tls import CertificateAuthority
 
 logger = logging.getLogger(__name__)
@@ -49,6 +50,8 @@ class DeploymentOptions:
     ready_timeout_s: float = 180.0
     log_dir: Path | None = None
     extra_sim_arguments: list[str] = field(default_factory=list)
+    restart_robot_side: bool = True
+    """Restart the robot side when a child ends (see sila_labware.supervisor)."""
 
 
 @dataclass(frozen=True)
@@ -101,6 +104,7 @@ class Deployment:
         self.robot: RobotController | None = None
         self.servers: list[ServedServer] = []
         self.ca_file: Path | None = None
+        self.supervisor: RobotSideSupervisor | None = None
 
     def start(self, should_stop: Callable[[], bool] = lambda: False) -> None:
         """Bring everything up; on any failure, stop what was started and re-raise."""
@@ -108,6 +112,11 @@ class Deployment:
             self._start_robot_side()
             self._start_bridge(should_stop)
             self._start_servers()
+            if self.options.restart_robot_side:
+                assert self.link is not None and self.robot is not None
+                self.supervisor = RobotSideSupervisor(
+                    self.children, self._start_robot_side, self.link, self.robot
+                ).start()
         except BaseException:
             self.stop()
             raise
@@ -165,6 +174,13 @@ class Deployment:
         if authority is not None:
             self.ca_file = authority.write_certificate(self.options.ca_file)
 
+    def check_healthy(self) -> None:
+        """Raise if the robot side is down for good (the supervisor gave up, or there is none)."""
+        if self.supervisor is None:
+            self.children.check_running()
+        elif self.supervisor.failure:
+            raise RuntimeError(self.supervisor.failure)
+
     def robot_server(self) -> ServedServer:
         return next(served for served in self.servers if served.role == "robot")
 
@@ -173,6 +189,9 @@ class Deployment:
 
     def stop(self) -> None:
         """Stop servers (in parallel), the bridge, then the children; about 3 s at worst."""
+        if self.supervisor is not None:
+            self.supervisor.stop()
+            self.supervisor = None
         stoppers = [
             threading.Thread(target=_stop_server, args=(served.server,), daemon=True)
             for served in self.servers

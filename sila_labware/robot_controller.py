@@ -231,6 +231,17 @@ class RobotController:
         goal.cancel()
         return True
 
+    def abort_active_goal(self, reason: str) -> bool:
+        """End the waiting command now with a failed outcome (the robot side is gone and will not
+        answer); True if one was waiting. The command then settles the inventory and raises its
+        defined error as for any failed goal."""
+        with self._active_lock:
+            goal = self._active_goal
+        if goal is None or goal.outcome.done():
+            return False
+        goal._finish_with_error(BridgeError(reason))
+        return True
+
     # --- helpers ---
 
     def _motion(self, command: str, send: Callable[[], ActionGoal]) -> None:

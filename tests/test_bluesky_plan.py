@@ -18,15 +18,13 @@ import pytest
 from bluesky import RunEngine
 from bluesky.utils import FailedStatus, RunEngineInterrupted
 from ophyd.sim import SynAxis, SynGauss
-from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
-from rcl_interfaces.srv import SetParameters
 from ros_processes import running
+from sim_parameters import set_node_parameter
 
 from ros_bridge.bluesky import ActionFailed, LabwareTransferRobot, NestSite, sample_exchange_plan
 from ros_bridge.bluesky.demo import MEASURE_POSITION_M, find_exchange_setup, run_bluesky_demo
 from ros_bridge.robot_link import RobotLink
 from ros_bridge.runtime import RosRuntime
-from ros_bridge.services import ServiceCaller
 
 DEFAULT_WORLD = Path(__file__).resolve().parents[1] / "tiago_sim" / "worlds" / "default.yaml"
 PLATE = "plate_001"
@@ -95,15 +93,7 @@ def assert_plate_in(link: RobotLink, site: NestSite) -> None:
 
 
 def set_sim_parameter(link: RobotLink, name: str, value: str | float) -> None:
-    caller = ServiceCaller(link.runtime, SetParameters, "/tiago_sim/set_parameters")
-    caller.wait_for_service(10.0)
-    if isinstance(value, str):
-        parameter_value = ParameterValue(type=ParameterType.PARAMETER_STRING, string_value=value)
-    else:
-        parameter_value = ParameterValue(type=ParameterType.PARAMETER_DOUBLE, double_value=float(value))
-    request = SetParameters.Request(parameters=[Parameter(name=name, value=parameter_value)])
-    response = caller.call(request, 10.0)
-    assert response.results[0].successful, response.results[0].reason
+    set_node_parameter(link.runtime, name, value)
 
 
 def test_the_workcell_offers_the_exchange_the_tests_assume(link: RobotLink) -> None:

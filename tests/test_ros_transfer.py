@@ -18,6 +18,7 @@ from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
 from rcl_interfaces.srv import SetParameters
 from ros_processes import RosCaller, running
 from sensor_msgs.msg import CameraInfo, Image, JointState
+from sim_parameters import parameter_request
 
 from tiago_sim.ros_publishers import CAMERA_IMAGE_TOPIC, CAMERA_INFO_TOPIC
 
@@ -71,9 +72,7 @@ def arm_joints(robot: RosCaller) -> dict[str, float]:
 
 
 def set_parameter(robot: RosCaller, name: str, text: str) -> None:
-    value = ParameterValue(type=ParameterType.PARAMETER_STRING, string_value=text)
-    request = SetParameters.Request(parameters=[Parameter(name=name, value=value)])
-    response = robot.call_service(SetParameters, "/tiago_sim/set_parameters", request)
+    response = robot.call_service(SetParameters, "/tiago_sim/set_parameters", parameter_request(name, text))
     assert response.results[0].successful, response.results[0].reason
 
 
@@ -119,16 +118,14 @@ def test_head_camera_is_published_when_subscribed(robot: RosCaller) -> None:
 
 
 def test_parameters_are_checked_and_applied_at_runtime(robot: RosCaller) -> None:
-    value = ParameterValue(type=ParameterType.PARAMETER_DOUBLE, double_value=50.0)
-    request = SetParameters.Request(parameters=[Parameter(name="speed_scale", value=value)])
+    request = parameter_request("speed_scale", 50.0)
     response = robot.call_service(SetParameters, "/tiago_sim/set_parameters", request)
     assert not response.results[0].successful and "speed_scale" in response.results[0].reason
     pose = ParameterValue(type=ParameterType.PARAMETER_DOUBLE_ARRAY, double_array_value=[0.0, 2.0, 0.0])
     request = SetParameters.Request(parameters=[Parameter(name="pois.spare_corner", value=pose)])
     response = robot.call_service(SetParameters, "/tiago_sim/set_parameters", request)
     assert not response.results[0].successful  # POIs are declared from the world file only
-    estimate = ParameterValue(type=ParameterType.PARAMETER_DOUBLE, double_value=25.0)
-    request = SetParameters.Request(parameters=[Parameter(name="estimates_s.navigate", value=estimate)])
+    request = parameter_request("estimates_s.navigate", 25.0)
     response = robot.call_service(SetParameters, "/labware_sequencer/set_parameters", request)
     assert response.results[0].successful
 

@@ -8,13 +8,11 @@ from collections.abc import Callable, Iterator
 from typing import Any
 
 import pytest
-from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
-from rcl_interfaces.srv import SetParameters
 from sila2.client import SilaClient
 from sila2.framework import DefinedExecutionError, ValidationError
 from sila_stack import client_for, start_stack
+from sim_parameters import set_node_parameter
 
-from ros_bridge.services import ServiceCaller
 from sila_labware.deployment import Deployment
 
 MANIPULATOR = "org.silastandard/instruments.labware.manipulation/LabwareTransferManipulatorController/v1"
@@ -232,11 +230,7 @@ def test_motion_commands_map_robot_side_errors(robot: SilaClient) -> None:
 
 def occlude_marker(stack: Deployment, station: str) -> None:
     """Fault injection the sim node offers for tests: hide a station's marker from the camera."""
-    set_parameters = ServiceCaller(stack.runtime, SetParameters, "/tiago_sim/set_parameters")
-    set_parameters.wait_for_service(10.0)
-    value = ParameterValue(type=ParameterType.PARAMETER_STRING, string_value=station)
-    request = SetParameters.Request(parameters=[Parameter(name="fault.occlude_marker", value=value)])
-    assert all(result.successful for result in set_parameters.call(request, 10.0).results)
+    set_node_parameter(stack.runtime, "fault.occlude_marker", station)
 
 
 def test_failed_get_is_labware_not_picked_and_inventory_stays_true(
@@ -269,12 +263,27 @@ def test_failed_get_is_labware_not_picked_and_inventory_stays_true(
     )
 
 
-def test_stop_motion_cancels_a_drive_through_the_whole_stack(robot: SilaClient) -> None:
+def test_stop_motion_cancels_a_drive_through_the_whole_stack(stack: Deployment, robot: SilaClient) -> None:
     """Runs last in this module: it leaves the robot undocked."""
     motion = robot.MobileRobotController
     finish(lambda: motion.Undock())
     assert motion.RobotState.get() == "Idle"
-    drive = motion.DriveToPointOfInterest(PointOfInterest="lab_centre")
+    # At real time the 2.4 m drive takes seconds of wall time, so StopMotion surely lands mid-drive
+    # (unpaced, a loaded machine may finish it before the stop arrives).
+    set_node_parameter(stack.runtime, "realtime_factor_cap", 1.0)
+    try:
+        drive = motion.DriveToPointOfInterest(PointOfInterest="lab_centre")
+        stop_mid_drive(motion, drive)
+    finally:
+        set_node_parameter(stack.runtime, "realtime_factor_cap", 0.0)
+    with pytest.raises(DefinedExecutionError) as caught:
+        drive.get_responses()
+    assert caught.value.identifier == "MotionStopped"
+    assert motion.CurrentPointOfInterest.get() != "lab_centre"
+
+
+def stop_mid_drive(motion: Any, drive: Any) -> None:
+    """Wait for the drive's first progress, check its estimate, stop it, wait for its end."""
     deadline = time.monotonic() + 30.0
     while not (drive.progress or 0.0) > 0.0:
         assert time.monotonic() < deadline and not drive.done, "the drive never reported progress"
@@ -284,7 +293,3 @@ def test_stop_motion_cancels_a_drive_through_the_whole_stack(robot: SilaClient) 
     while not drive.done:
         assert time.monotonic() < deadline, "the drive did not end after StopMotion"
         time.sleep(0.05)
-    with pytest.raises(DefinedExecutionError) as caught:
-        drive.get_responses()
-    assert caught.value.identifier == "MotionStopped"
-    assert motion.CurrentPointOfInterest.get() != "lab_centre"

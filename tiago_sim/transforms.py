@@ -64,7 +64,9 @@ def rpy_to_matrix(roll: float, pitch: float, yaw: float) -> np.ndarray:
     )
 
 
-def make_transform(translation: Sequence[float] = (0.0, 0.0, 0.0), rotation: np.ndarray | None = None) -> Matrix4:
+def make_transform(
+    translation: Sequence[float] = (0.0, 0.0, 0.0), rotation: np.ndarray | None = None
+) -> Matrix4:
     """4x4 transform from a translation and an optional 3x3 rotation."""
     transform = np.eye(4)
     transform[:3, 3] = np.asarray(translation, dtype=float)
