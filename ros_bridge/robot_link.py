@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
 
 from labware_interfaces.action import Dock, GetLabware, NavigateToPoi, PutLabware, Undock
 from labware_interfaces.msg import RobotState, StationStates
@@ -59,6 +61,28 @@ def nest_occupancies_from_message(message: StationStates) -> tuple[NestOccupancy
     )
 
 
+@dataclass(frozen=True)
+class LabwareHandover:
+    """What GetLabware and PutLabware goals carry: the station nest, the hotel slot, the plate."""
+
+    station: str
+    sub_position: int
+    hotel_slot: int
+    labware_type: str
+    labware_id: str
+    intermediate_actions: Sequence[str] = ()
+
+    def goal(self, goal_type: Callable[..., Any]) -> Any:
+        return goal_type(
+            handover_position=self.station,
+            sub_position=self.sub_position,
+            internal_position=self.hotel_slot,
+            labware_type=self.labware_type,
+            labware_id=self.labware_id,
+            intermediate_actions=list(self.intermediate_actions),
+        )
+
+
 class RobotLink:
     """Clients of every robot-side action, service and topic, sharing one `RosRuntime`."""
 
@@ -95,44 +119,16 @@ class RobotLink:
         return self._undock.send(Undock.Goal(), on_feedback)
 
     def get_labware(
-        self,
-        station: str,
-        sub_position: int,
-        hotel_slot: int,
-        labware_type: str,
-        labware_id: str,
-        intermediate_actions: Sequence[str] = (),
-        on_feedback: FeedbackListener | None = None,
+        self, handover: LabwareHandover, on_feedback: FeedbackListener | None = None
     ) -> ActionGoal:
-        goal = GetLabware.Goal(
-            handover_position=station,
-            sub_position=sub_position,
-            internal_position=hotel_slot,
-            labware_type=labware_type,
-            labware_id=labware_id,
-            intermediate_actions=list(intermediate_actions),
-        )
-        return self._get_labware.send(goal, on_feedback)
+        """Take the plate from the station nest into the hotel slot."""
+        return self._get_labware.send(handover.goal(GetLabware.Goal), on_feedback)
 
     def put_labware(
-        self,
-        station: str,
-        sub_position: int,
-        hotel_slot: int,
-        labware_type: str,
-        labware_id: str,
-        intermediate_actions: Sequence[str] = (),
-        on_feedback: FeedbackListener | None = None,
+        self, handover: LabwareHandover, on_feedback: FeedbackListener | None = None
     ) -> ActionGoal:
-        goal = PutLabware.Goal(
-            handover_position=station,
-            sub_position=sub_position,
-            internal_position=hotel_slot,
-            labware_type=labware_type,
-            labware_id=labware_id,
-            intermediate_actions=list(intermediate_actions),
-        )
-        return self._put_labware.send(goal, on_feedback)
+        """Place the plate of the hotel slot into the station nest."""
+        return self._put_labware.send(handover.goal(PutLabware.Goal), on_feedback)
 
     # --- services ---
 

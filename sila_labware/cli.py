@@ -20,6 +20,7 @@ import threading
 from collections.abc import Sequence
 from pathlib import Path
 from types import FrameType
+from typing import TYPE_CHECKING
 
 from sila_labware.bench_cli import (
     add_bench_arguments,
@@ -28,6 +29,9 @@ from sila_labware.bench_cli import (
     validate_bench,
     write_recorded_pictures,
 )
+
+if TYPE_CHECKING:
+    from sila_labware.deployment import Deployment
 
 logger = logging.getLogger("sila_labware")
 
@@ -197,18 +201,28 @@ def _print_servers(deployment, stream) -> None:
     stream.flush()
 
 
-def serve(args: argparse.Namespace) -> int:
+def _start(args: argparse.Namespace) -> tuple[Deployment | None, _StopRequest]:
+    """Start the deployment; None if it could not start (the reason is on stderr) or was stopped
+    while starting (then the stop request is set)."""
     stop = _StopRequest()
     stop.install()
     deployment = _deployment_from(args)
     try:
         deployment.start(should_stop=stop.event.is_set)
     except KeyboardInterrupt:
-        return 0
+        stop.event.set()
+        return None, stop
     except Exception as error:  # noqa: BLE001 - one line for the user, details in the log
         logger.debug("start failed", exc_info=True)
         sys.stderr.write(f"sila-labware: could not start: {error}\n")
-        return 1
+        return None, stop
+    return deployment, stop
+
+
+def serve(args: argparse.Namespace) -> int:
+    deployment, stop = _start(args)
+    if deployment is None:
+        return 0 if stop.event.is_set() else 1
     try:
         _print_servers(deployment, sys.stdout)
         sys.stdout.write("serving; Ctrl-C stops\n")
@@ -226,15 +240,8 @@ def serve(args: argparse.Namespace) -> int:
 def demo(args: argparse.Namespace) -> int:
     from sila_labware.demo import run_demo
 
-    stop = _StopRequest()
-    stop.install()
-    deployment = _deployment_from(args)
-    try:
-        deployment.start(should_stop=stop.event.is_set)
-    except KeyboardInterrupt:
-        return 1
-    except Exception as error:  # noqa: BLE001
-        sys.stderr.write(f"sila-labware: could not start: {error}\n")
+    deployment, _stop = _start(args)
+    if deployment is None:
         return 1
     try:
         _print_servers(deployment, sys.stderr)

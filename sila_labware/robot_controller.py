@@ -21,7 +21,7 @@ from collections.abc import Callable
 
 from ros_bridge.actions import ActionGoal, ActionOutcome, GoalProgress
 from ros_bridge.errors import BridgeError, BridgeTimeout
-from ros_bridge.robot_link import RobotLink
+from ros_bridge.robot_link import LabwareHandover, RobotLink
 from ros_bridge.workcell import RobotStatus, WorkcellDescription
 from sila_labware.errors import CommandSequenceError, ParameterError
 from sila_labware.inventory import Inventory, in_hotel
@@ -150,27 +150,7 @@ class RobotController:
         report: ProgressReport | None = None,
     ) -> str:
         """Take the plate from the prepared station into the prepared hotel slot; returns its id."""
-        handover = check_handover(position, sub_position, self._sub_positions)
-        check_intermediate_actions(intermediate_actions, INTERMEDIATE_ACTIONS)
-        transfer = self.sequence.begin_get(handover)
-        try:
-            goal = self.link.get_labware(
-                handover.station,
-                handover.sub_position,
-                transfer.internal_position,
-                transfer.labware_type,
-                transfer.labware_id,
-                intermediate_actions,
-                on_feedback=_ScaledReport(report, 0.0, 1.0),
-            )
-            outcome = self._wait(goal, "GetLabware")
-            labware_id = transfer.labware_id or str(getattr(outcome.result, "labware_id", ""))
-            self._settle(labware_id, transfer, outcome, expect_aboard=True)
-            if not outcome.success:
-                raise TransferFailed(outcome.error_code, _describe_failure("GetLabware", outcome))
-            return labware_id
-        finally:
-            self.sequence.finish_transfer()
+        return self._transfer("GetLabware", position, sub_position, intermediate_actions, report)
 
     def put_labware(
         self,
@@ -180,24 +160,38 @@ class RobotController:
         report: ProgressReport | None = None,
     ) -> str:
         """Place the plate of the prepared hotel slot into the prepared station nest; returns its id."""
+        return self._transfer("PutLabware", position, sub_position, intermediate_actions, report)
+
+    def _transfer(
+        self,
+        command: str,
+        position: str,
+        sub_position: int,
+        intermediate_actions: list[str],
+        report: ProgressReport | None,
+    ) -> str:
+        """GetLabware or PutLabware: check, match the prepared transfer, run the goal, settle the
+        inventory from what the robot observed, then raise TransferFailed if the goal failed."""
+        getting = command == "GetLabware"
         handover = check_handover(position, sub_position, self._sub_positions)
         check_intermediate_actions(intermediate_actions, INTERMEDIATE_ACTIONS)
-        transfer = self.sequence.begin_put(handover)
+        transfer = self.sequence.begin_get(handover) if getting else self.sequence.begin_put(handover)
         try:
-            goal = self.link.put_labware(
+            request = LabwareHandover(
                 handover.station,
                 handover.sub_position,
                 transfer.internal_position,
                 transfer.labware_type,
                 transfer.labware_id,
                 intermediate_actions,
-                on_feedback=_ScaledReport(report, 0.0, 1.0),
             )
-            outcome = self._wait(goal, "PutLabware")
+            send = self.link.get_labware if getting else self.link.put_labware
+            goal = send(request, _ScaledReport(report, 0.0, 1.0))
+            outcome = self._wait(goal, command)
             labware_id = transfer.labware_id or str(getattr(outcome.result, "labware_id", ""))
-            self._settle(labware_id, transfer, outcome, expect_aboard=False)
+            self._settle(labware_id, transfer, outcome, expect_aboard=getting)
             if not outcome.success:
-                raise TransferFailed(outcome.error_code, _describe_failure("PutLabware", outcome))
+                raise TransferFailed(outcome.error_code, _describe_failure(command, outcome))
             return labware_id
         finally:
             self.sequence.finish_transfer()

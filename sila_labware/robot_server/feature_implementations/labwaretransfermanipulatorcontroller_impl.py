@@ -110,19 +110,7 @@ class LabwareTransferManipulatorControllerImpl(LabwareTransferManipulatorControl
         metadata: MetadataDict,
         instance: ObservableCommandInstance,
     ) -> PutLabware_Responses:
-        instance.begin_execution()
-        try:
-            self._run(
-                "PutLabware",
-                lambda: self.robot.put_labware(
-                    HandoverPosition.Position,
-                    HandoverPosition.SubPosition,
-                    list(IntermediateActions),
-                    progress_reporter(instance),
-                ),
-            )
-        except TransferFailed as failure:
-            raise LabwareNotPlaced(failure.message) from failure
+        self._transfer("PutLabware", HandoverPosition, IntermediateActions, instance, LabwareNotPlaced)
         return PutLabware_Responses()
 
     def GetLabware(
@@ -133,20 +121,32 @@ class LabwareTransferManipulatorControllerImpl(LabwareTransferManipulatorControl
         metadata: MetadataDict,
         instance: ObservableCommandInstance,
     ) -> GetLabware_Responses:
+        self._transfer("GetLabware", HandoverPosition, IntermediateActions, instance, LabwareNotPicked)
+        return GetLabware_Responses()
+
+    def _transfer(
+        self,
+        command: str,
+        handover: HandoverPosition,
+        intermediate_actions: list[str],
+        instance: ObservableCommandInstance,
+        failed: Callable[[str], Exception],
+    ) -> None:
+        """Run GetLabware/PutLabware; a failed transfer becomes the command's own defined error."""
         instance.begin_execution()
+        method = self.robot.get_labware if command == "GetLabware" else self.robot.put_labware
         try:
             self._run(
-                "GetLabware",
-                lambda: self.robot.get_labware(
-                    HandoverPosition.Position,
-                    HandoverPosition.SubPosition,
-                    list(IntermediateActions),
+                command,
+                lambda: method(
+                    handover.Position,
+                    handover.SubPosition,
+                    list(intermediate_actions),
                     progress_reporter(instance),
                 ),
             )
         except TransferFailed as failure:
-            raise LabwareNotPicked(failure.message) from failure
-        return GetLabware_Responses()
+            raise failed(failure.message) from failure
 
     def _run(self, command: str, action: Callable[[], T]) -> T:
         """Translate the logic's errors; TransferFailed is left to the caller (it knows which error)."""
