@@ -1,4 +1,4 @@
-"""Test and fault injection for the sim node: hide a station's marker from the head camera.
+"""Test and fault injection for the sim node: hide a marker, take a plate away, drop one mid-drive.
 
 Why: a test of MARKER_NOT_FOUND needs a real occlusion in the rendered image, not a flag in
 the perception code. The occluder is a visual-only panel (no collision shape, so it cannot push
@@ -53,3 +53,103 @@ class Occluders:
         )
         self.station = station_name
         log.info("marker of %s occluded (fault injection)", station_name)
+
+
+PARKING_MARGIN_M = 0.5  # removed plates lie on the floor this far inside its corner, away from every path
+DROP_SIDEWAYS_M = 0.45  # beside the tray: clear of the base (r 0.27 m) plus half a plate diagonal
+DROP_HEIGHT_M = 0.02  # just above the tray, so the plate falls from hotel height
+DROP_PUSH_M_S = 0.5  # outward push the slipping plate gets
+DRIVING_SPEED_M_S = 0.2  # the base counts as driving (not turning on the spot) above this speed
+
+
+class PlateFaults:
+    """Physical plate faults: a plate taken away from its place, or lost from the hotel mid-drive.
+
+    ``remove(sim, plate)`` moves the plate onto the floor far from every station (as if someone
+    took it); ``arm_drop(plate)`` makes the plate slip out of the hotel the next time the base
+    drives, and physics drops it on the floor beside the robot; ``restore(sim)`` puts every plate
+    moved or dropped this way back where the world file puts it (if that place is free), so a test
+    can go on. Nothing here tells the robot software: it must find out from its sensors.
+    Uses the simulation's own (true) world. Runs on: the sim thread.
+    """
+
+    def __init__(self) -> None:
+        self.drop_armed = ""
+        self.faulted: set[str] = set()
+
+    def remove(self, sim: Any, labware_id: str) -> None:
+        body = self._body(sim, labware_id)
+        corner = sim.world.floor_size / 2 - PARKING_MARGIN_M
+        labware = sim.scene.plate_types[labware_id]
+        p.resetBasePositionAndOrientation(
+            body, [corner, corner, labware.height / 2 + 0.001], [0, 0, 0, 1], physicsClientId=sim.client_id
+        )
+        p.resetBaseVelocity(body, [0, 0, 0], [0, 0, 0], physicsClientId=sim.client_id)
+        self.faulted.add(labware_id)
+        log.info(
+            "plate %s removed to the floor at (%.1f, %.1f) (fault injection)", labware_id, corner, corner
+        )
+
+    def arm_drop(self, sim: Any, labware_id: str) -> None:
+        self._body(sim, labware_id)
+        self.drop_armed = labware_id
+        log.info("plate %s will slip out of the hotel during the next drive (fault injection)", labware_id)
+
+    def drop_if_driving(self, sim: Any) -> bool:
+        """Called on the sim thread while a drop is armed: push the plate off the tray once the base
+        drives with it aboard; True when it did."""
+        labware_id = self.drop_armed
+        if not labware_id or abs(sim.base.v) < DRIVING_SPEED_M_S:
+            return False
+        slot = next((index for index, found, _ in sim.hotel_occupancy() if found == labware_id), 0)
+        if not slot:
+            return False
+        T_world_slot = sim.robot.link_pose(f"hotel_slot_{slot}")
+        side = 1.0 if slot % 2 else -1.0
+        labware = sim.scene.plate_types[labware_id]
+        T_world_start = T_world_slot @ make_transform(
+            (0.0, side * DROP_SIDEWAYS_M, DROP_HEIGHT_M + labware.height / 2)
+        )
+        position, quat = to_pose(T_world_start)
+        outward = T_world_slot[:3, 1] * side * DROP_PUSH_M_S
+        body = sim.scene.plates[labware_id]
+        p.resetBasePositionAndOrientation(
+            body, position.tolist(), quat.tolist(), physicsClientId=sim.client_id
+        )
+        p.resetBaseVelocity(body, outward.tolist(), [0, 0, 0], physicsClientId=sim.client_id)
+        self.drop_armed = ""
+        self.faulted.add(labware_id)
+        log.info("plate %s slipped out of hotel slot %d mid-drive (fault injection)", labware_id, slot)
+        return True
+
+    def restore(self, sim: Any) -> None:
+        """Put faulted plates back at their world-file nests (skipped where a plate already sits)."""
+        self.drop_armed = ""
+        for plate in sim.world.plates:
+            if plate.labware_id not in self.faulted or not plate.station:
+                continue
+            T_world_site = sim.world.station(plate.station).T_world_site(plate.sub_position)
+            if sim._plate_near(T_world_site):
+                log.warning("not restoring %s: its nest is taken", plate.labware_id)
+                continue
+            labware = sim.scene.plate_types[plate.labware_id]
+            position, quat = to_pose(T_world_site @ make_transform((0.0, 0.0, labware.height / 2 + 0.0005)))
+            body = sim.scene.plates[plate.labware_id]
+            p.resetBasePositionAndOrientation(
+                body, position.tolist(), quat.tolist(), physicsClientId=sim.client_id
+            )
+            p.resetBaseVelocity(body, [0, 0, 0], [0, 0, 0], physicsClientId=sim.client_id)
+            self.faulted.discard(plate.labware_id)
+            log.info("plate %s restored to %s/%d", plate.labware_id, plate.station, plate.sub_position)
+
+    @staticmethod
+    def _body(sim: Any, labware_id: str) -> int:
+        if labware_id not in sim.scene.plates:
+            raise ValueError(f"unknown plate {labware_id!r}")
+        return sim.scene.plates[labware_id]
+
+
+def _teleport(sim: Any, body: int, position: list, quat: list, velocity: list | None = None) -> None:
+    """Move a body and give it a velocity (zero unless given); physics takes over from there."""
+    p.resetBasePositionAndOrientation(body, position, quat, physicsClientId=sim.client_id)
+    p.resetBaseVelocity(body, velocity or [0, 0, 0], [0, 0, 0], physicsClientId=sim.client_id)

@@ -10,8 +10,11 @@ success checks only).
 
 ROS parameters (changeable at runtime): ``pois.<name>`` = [x, y, yaw] (from the world YAML),
 ``stations.<name>.approach_height_m``, ``speed_scale``, ``realtime_factor_cap`` (0 = none),
-``idle_realtime_factor``, and - for tests only, as fault injection - ``fault.occlude_marker``:
-a station name whose marker gets hidden behind a visual-only panel (empty: none).
+``idle_realtime_factor``, and - for tests only, as fault injection (tiago_sim.fault_injection) -
+``fault.occlude_marker``: a station name whose marker gets hidden behind a visual-only panel
+(empty: none); ``fault.remove_plate``: a plate id taken away onto the floor far from every station;
+``fault.drop_plate``: a plate id that slips out of the hotel during the next drive. Setting either
+plate fault to empty puts faulted plates back at their world-file nests.
 """
 
 from __future__ import annotations
@@ -33,7 +36,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
 
-from tiago_sim.fault_injection import Occluders
+from tiago_sim.fault_injection import Occluders, PlateFaults
 from tiago_sim.marker_motion import MarkerMotionBehaviour
 from tiago_sim.motion_library import DEFAULT_MOTIONS_FILE, load_motions
 from tiago_sim.robot_behaviours import RobotBehaviours
@@ -53,6 +56,7 @@ class SimNode:
         self.world = world
         self.sim_thread = sim_thread
         self.occluders = Occluders(world)
+        self.plate_faults = PlateFaults()
         self._declare_parameters()
         motions = load_motions(motions_file)
         self.behaviours = RobotBehaviours(
@@ -81,6 +85,7 @@ class SimNode:
         node.create_service(DescribeWorkcell, "/describe_workcell", self._describe_workcell)
         node.create_service(CheckPlacement, "/check_placement", self._check_placement)
         node.add_on_set_parameters_callback(self._on_parameters)
+        node.create_timer(0.05, self._watch_armed_drop)
 
     # -- parameters ------------------------------------------------------------------------
     def _declare_parameters(self) -> None:
@@ -92,6 +97,8 @@ class SimNode:
         self.node.declare_parameter("realtime_factor_cap", float(self.sim_thread.realtime_factor_cap or 0.0))
         self.node.declare_parameter("idle_realtime_factor", float(self.sim_thread.idle_realtime_factor))
         self.node.declare_parameter("fault.occlude_marker", "")
+        self.node.declare_parameter("fault.remove_plate", "")
+        self.node.declare_parameter("fault.drop_plate", "")
 
     def _on_parameters(self, parameters: list[Parameter]) -> SetParametersResult:
         for parameter in parameters:
@@ -106,6 +113,9 @@ class SimNode:
                 and value not in {s.name for s in self.world.stations}
             ):
                 return SetParametersResult(successful=False, reason=f"unknown station {value!r}")
+            plates = {plate.labware_id for plate in self.world.plates}
+            if name in ("fault.remove_plate", "fault.drop_plate") and value and value not in plates:
+                return SetParametersResult(successful=False, reason=f"unknown plate {value!r}")
         for parameter in parameters:
             self._apply(parameter.name, parameter.value)
         return SetParametersResult(successful=True)
@@ -118,6 +128,8 @@ class SimNode:
         elif name == "fault.occlude_marker":
             station = str(value)
             self.sim_thread.call(lambda sim: self.occluders.set_occluded(sim, station))
+        elif name in ("fault.remove_plate", "fault.drop_plate"):
+            self.sim_thread.run(lambda sim: self._apply_plate_fault(sim, name, str(value)))
         elif name.startswith("stations.") and name.endswith(".approach_height_m"):
             station_name = name[len("stations.") : -len(".approach_height_m")]
             stations = tuple(
@@ -126,6 +138,19 @@ class SimNode:
             )
             self.world = dataclasses.replace(self.world, stations=stations)
             self.marker_motion.world = self.world
+
+    def _apply_plate_fault(self, sim: Any, name: str, labware_id: str) -> None:
+        if not labware_id:
+            self.plate_faults.restore(sim)
+        elif name == "fault.remove_plate":
+            self.plate_faults.remove(sim, labware_id)
+        else:
+            self.plate_faults.arm_drop(sim, labware_id)
+
+    def _watch_armed_drop(self) -> None:
+        """Timer: while a drop is armed, let the sim thread check whether the base drives now."""
+        if self.plate_faults.drop_armed:
+            self.sim_thread.call(self.plate_faults.drop_if_driving)
 
     def current_pois(self) -> dict[str, tuple[float, float, float]]:
         pois = {}
