@@ -115,6 +115,16 @@ def _install_package(fresh_package: Path, target_package: Path) -> None:
             logger.warning("added %s: register the new feature in %s/server.py", target_impl, target_package)
 
 
+def _fresh_packages(
+    features_dir: Path, server_features: Mapping[str, Sequence[str]]
+) -> Iterator[tuple[str, Sequence[str], Path]]:
+    """Generate each server package into a temporary directory: (name, feature files, package dir)."""
+    for package_name, feature_files in server_features.items():
+        with tempfile.TemporaryDirectory(prefix=f"codegen-{package_name}-") as tmp:
+            fresh = generate_package(package_name, _fdl_paths(feature_files, features_dir), Path(tmp))
+            yield package_name, feature_files, fresh
+
+
 def regenerate(
     packages_dir: Path = PACKAGES_DIR,
     features_dir: Path = FEATURES_DIR,
@@ -122,13 +132,11 @@ def regenerate(
 ) -> list[Path]:
     """Regenerate every package's generated/ tree from features/; return the package directories."""
     written = []
-    for package_name, feature_files in server_features.items():
-        with tempfile.TemporaryDirectory(prefix=f"codegen-{package_name}-") as tmp:
-            fresh = generate_package(package_name, _fdl_paths(feature_files, features_dir), Path(tmp))
-            target = packages_dir / package_name
-            _install_package(fresh, target)
-            logger.info("regenerated %s/generated from %s", target, ", ".join(feature_files))
-            written.append(target)
+    for package_name, feature_files, fresh in _fresh_packages(features_dir, server_features):
+        target = packages_dir / package_name
+        _install_package(fresh, target)
+        logger.info("regenerated %s/generated from %s", target, ", ".join(feature_files))
+        written.append(target)
     return written
 
 
@@ -139,14 +147,12 @@ def stale_files(
 ) -> list[str]:
     """Files of the committed generated/ trees that differ from a fresh generation (empty: up to date)."""
     problems = []
-    for package_name, feature_files in server_features.items():
-        with tempfile.TemporaryDirectory(prefix=f"codegen-{package_name}-") as tmp:
-            fresh = generate_package(package_name, _fdl_paths(feature_files, features_dir), Path(tmp))
-            committed = packages_dir / package_name / "generated"
-            problems += [
-                f"{package_name}/generated: {difference}"
-                for difference in differing_files(fresh / "generated", committed)
-            ]
+    for package_name, _feature_files, fresh in _fresh_packages(features_dir, server_features):
+        committed = packages_dir / package_name / "generated"
+        problems += [
+            f"{package_name}/generated: {difference}"
+            for difference in differing_files(fresh / "generated", committed)
+        ]
     return problems
 
 
