@@ -135,6 +135,7 @@ class RobotController:
             raise CommandSequenceError(
                 f"PrepareForOutput refused: internal position {internal_position} holds no labware"
             )
+        self._refuse_occupied_destination(handover)
         known = self.inventory.locate(occupant)
         transfer = PreparedTransfer(
             handover, internal_position, known.labware_type if known else "", occupant
@@ -321,6 +322,17 @@ class RobotController:
             logger.warning(
                 "GetLabware succeeded but %s is at %s, not %s", labware_id, location, expected_slot
             )
+
+    def _refuse_occupied_destination(self, handover: Handover) -> None:
+        """Before any motion: a nest whose sensor sees a plate cannot take another one."""
+        for nest in self.link.nest_occupancies():
+            here = (nest.station, nest.sub_position) == (handover.station, handover.sub_position)
+            if here and nest.occupied:
+                holder = f" (holds {nest.labware_id})" if nest.labware_id else ""
+                raise CommandSequenceError(
+                    f"PrepareForOutput refused: destination {handover.station}/{handover.sub_position} "
+                    f"is occupied{holder}; the robot did not move"
+                )
 
     @staticmethod
     def _hotel_occupant(status: RobotStatus, slot: int) -> str | None:

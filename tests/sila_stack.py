@@ -36,10 +36,12 @@ def free_port_base(count: int) -> int:
     raise RuntimeError("no block of free ports found")
 
 
-def start_stack(tmp_dir: Path, *, insecure: bool = False, discovery: bool = False) -> Deployment:
+def start_stack(
+    tmp_dir: Path, *, insecure: bool = False, discovery: bool = False, world: Path = DEFAULT_WORLD
+) -> Deployment:
     deployment = Deployment(
         DeploymentOptions(
-            world=DEFAULT_WORLD,
+            world=world,
             host="127.0.0.1",
             port_base=free_port_base(4),
             insecure=insecure,
