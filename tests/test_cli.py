@@ -11,6 +11,8 @@ import sys
 import time
 from pathlib import Path
 
+import cv2
+import numpy as np
 import pytest
 from sila2.client import SilaClient
 from sila_stack import free_port_base
@@ -99,10 +101,13 @@ def test_serve_prints_servers_and_stops_everything_quickly(
             serve.wait()
 
 
-def test_demo_json_reports_the_transfer(tmp_path: Path) -> None:
+def test_demo_json_reports_the_transfer_and_records_pictures(tmp_path: Path) -> None:
+    record_dir = tmp_path / "record"
     done = run_cli(
         "demo",
         "--json",
+        "--record",
+        str(record_dir),
         "--insecure",
         "--no-discovery",
         "--port-base",
@@ -125,3 +130,16 @@ def test_demo_json_reports_the_transfer(tmp_path: Path) -> None:
     assert report["success"] is True, report
     assert done.returncode == 0, done.stderr[-2000:]
     assert "without encryption" in done.stderr.lower()
+    assert_run_pictures(record_dir)
+
+
+def assert_run_pictures(record_dir: Path) -> None:
+    """`demo --record DIR`: an image strip, a GIF, and head-camera frames with the marker outlined."""
+    strip = cv2.imread(str(record_dir / "run_strip.png"))
+    assert strip is not None and strip.shape[0] >= 480 and strip.std() > 10
+    assert (record_dir / "run.gif").stat().st_size > 1000
+    head_frames = sorted((record_dir / "frames").glob("head_*.png"))
+    assert len(head_frames) >= 2  # one sighting at each station
+    # the outline drawn around the detected marker is the detector's colour (255, 200, 0) in RGB
+    outlined = cv2.cvtColor(cv2.imread(str(head_frames[0])), cv2.COLOR_BGR2RGB)
+    assert (np.abs(outlined.astype(int) - (255, 200, 0)).sum(axis=2) < 30).sum() > 20
