@@ -4,6 +4,9 @@ Each child runs in its own process group (new session), so stopping it also stop
 started; stop sends SIGTERM to every group, waits, then SIGKILLs what is left. Every child gets
 the ROS environment of this deployment (domain id, localhost-only discovery).
 
+A child's output goes to `<log_dir>/<name>.log`, or without a log directory to an anonymous
+temporary file (a few kB per transfer), so that a child that dies can always say why.
+
 Threads: used from the thread that runs the deployment (the CLI's main thread).
 """
 
@@ -14,10 +17,12 @@ import os
 import signal
 import subprocess
 import sys
+import tempfile
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import IO
 
 logger = logging.getLogger(__name__)
 
@@ -32,6 +37,13 @@ def ros_environment(domain_id: int, base: Mapping[str, str] | None = None) -> di
     return environment
 
 
+INPUT_REFUSED_EXIT_CODE = 2
+"""A child exiting with this code refused its input (a bad world file, bad arguments) and wrote why
+as its last line of output; that line alone is the message (e.g. `sila-labware serve` shows it)."""
+
+LOG_TAIL_BYTES = 64 * 1024
+
+
 class ChildExited(RuntimeError):
     """A child process ended while the deployment needed it."""
 
@@ -41,15 +53,25 @@ class Child:
     name: str
     popen: subprocess.Popen
     log_path: Path | None
+    output_file: IO[bytes] | None = None
+    """The anonymous file the child writes to when there is no log directory."""
 
     @property
     def running(self) -> bool:
         return self.popen.poll() is None
 
     def log_tail(self, lines: int = 15) -> str:
-        if self.log_path is None or not self.log_path.exists():
+        if self.log_path is not None and self.log_path.exists():
+            text = self.log_path.read_text(errors="replace")
+        elif self.output_file is not None and not self.output_file.closed:
+            # pread: the child shares this file's offset, so never seek it.
+            descriptor = self.output_file.fileno()
+            size = os.fstat(descriptor).st_size
+            start = max(0, size - LOG_TAIL_BYTES)
+            text = os.pread(descriptor, size - start, start).decode(errors="replace")
+        else:
             return ""
-        return "\n".join(self.log_path.read_text(errors="replace").splitlines()[-lines:])
+        return "\n".join(text.splitlines()[-lines:])
 
 
 class ProcessGroup:
@@ -64,11 +86,13 @@ class ProcessGroup:
         """Run `python -m module arguments...` with this interpreter; output goes to a log file."""
         argv = [sys.executable, "-m", module, *arguments]
         log_path = None
-        output = subprocess.DEVNULL
+        output_file = None
         if self._log_dir is not None:
             self._log_dir.mkdir(parents=True, exist_ok=True)
             log_path = self._log_dir / f"{name}.log"
             output = log_path.open("wb")
+        else:
+            output = output_file = tempfile.TemporaryFile(prefix=f"sila-labware-{name}-")
         popen = subprocess.Popen(
             argv,
             env=self._environment,
@@ -77,9 +101,9 @@ class ProcessGroup:
             stdin=subprocess.DEVNULL,
             start_new_session=True,
         )
-        if output is not subprocess.DEVNULL:
+        if output_file is None:
             output.close()  # the child holds its own descriptor
-        child = Child(name, popen, log_path)
+        child = Child(name, popen, log_path, output_file)
         self.children.append(child)
         logger.info("started %s (pid %d): %s", name, popen.pid, " ".join(argv))
         return child
@@ -90,6 +114,8 @@ class ProcessGroup:
             code = child.popen.poll()
             if code is not None:
                 tail = child.log_tail()
+                if code == INPUT_REFUSED_EXIT_CODE and tail:
+                    raise ChildExited(f"{child.name}: {tail.splitlines()[-1]}")
                 raise ChildExited(
                     f"{child.name} exited with code {code}"
                     + (f"; last lines of its log:\n{tail}" if tail else "")
@@ -107,6 +133,9 @@ class ProcessGroup:
                 logger.warning("%s did not stop on SIGTERM within %.1f s: killing it", child.name, timeout_s)
                 _signal_group(child, signal.SIGKILL)
                 child.popen.wait(2.0)
+        for child in self.children:
+            if child.output_file is not None:
+                child.output_file.close()
         self.children.clear()
 
     def __enter__(self) -> ProcessGroup:

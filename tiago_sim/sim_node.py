@@ -43,9 +43,12 @@ from tiago_sim.robot_behaviours import RobotBehaviours
 from tiago_sim.ros_actions import RobotActionServers
 from tiago_sim.ros_publishers import StatePublishers
 from tiago_sim.sim_thread import SimThread
-from tiago_sim.world import DEFAULT_WORLD, World, load_world
+from tiago_sim.world import DEFAULT_WORLD, World, WorldError, load_world
 
 log = logging.getLogger("tiago_sim.sim_node")
+
+INVALID_WORLD_EXIT_CODE = 2
+"""Exit code for a world file that does not validate; the reason is the last line on stderr."""
 
 
 class SimNode:
@@ -249,7 +252,12 @@ def _levels(args: argparse.Namespace) -> Any:
 def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
     logging.basicConfig(level=args.log_level, format="%(asctime)s %(levelname)s %(name)s: %(message)s")
-    world = load_world(args.world)
+    try:
+        world = load_world(args.world)
+    except WorldError as error:
+        # One line (YAML parser messages span several) that a parent process can show as it is.
+        sys.stderr.write(f"invalid world file: {' '.join(str(error).split())}\n")
+        return INVALID_WORLD_EXIT_CODE
     from tiago_sim.simulation import Simulation  # heavy import (PyBullet), only in the process that owns it
 
     sim_thread = SimThread(
