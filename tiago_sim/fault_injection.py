@@ -81,14 +81,9 @@ class PlateFaults:
         body = self._body(sim, labware_id)
         corner = sim.world.floor_size / 2 - PARKING_MARGIN_M
         labware = sim.scene.plate_types[labware_id]
-        p.resetBasePositionAndOrientation(
-            body, [corner, corner, labware.height / 2 + 0.001], [0, 0, 0, 1], physicsClientId=sim.client_id
-        )
-        p.resetBaseVelocity(body, [0, 0, 0], [0, 0, 0], physicsClientId=sim.client_id)
+        _teleport(sim, body, [corner, corner, labware.height / 2 + 0.001], [0, 0, 0, 1])
         self.faulted.add(labware_id)
-        log.info(
-            "plate %s removed to the floor at (%.1f, %.1f) (fault injection)", labware_id, corner, corner
-        )
+        log.info("plate %s taken to the floor at (%.1f, %.1f) (fault injection)", labware_id, corner, corner)
 
     def arm_drop(self, sim: Any, labware_id: str) -> None:
         self._body(sim, labware_id)
@@ -112,11 +107,7 @@ class PlateFaults:
         )
         position, quat = to_pose(T_world_start)
         outward = T_world_slot[:3, 1] * side * DROP_PUSH_M_S
-        body = sim.scene.plates[labware_id]
-        p.resetBasePositionAndOrientation(
-            body, position.tolist(), quat.tolist(), physicsClientId=sim.client_id
-        )
-        p.resetBaseVelocity(body, outward.tolist(), [0, 0, 0], physicsClientId=sim.client_id)
+        _teleport(sim, sim.scene.plates[labware_id], position.tolist(), quat.tolist(), outward.tolist())
         self.drop_armed = ""
         self.faulted.add(labware_id)
         log.info("plate %s slipped out of hotel slot %d mid-drive (fault injection)", labware_id, slot)
@@ -129,16 +120,14 @@ class PlateFaults:
             if plate.labware_id not in self.faulted or not plate.station:
                 continue
             T_world_site = sim.world.station(plate.station).T_world_site(plate.sub_position)
-            if sim._plate_near(T_world_site):
+            nest = (plate.station, plate.sub_position)
+            if any((name, sub) == nest and occupied for name, sub, occupied, _ in sim.nest_occupancy()):
                 log.warning("not restoring %s: its nest is taken", plate.labware_id)
                 continue
             labware = sim.scene.plate_types[plate.labware_id]
-            position, quat = to_pose(T_world_site @ make_transform((0.0, 0.0, labware.height / 2 + 0.0005)))
-            body = sim.scene.plates[plate.labware_id]
-            p.resetBasePositionAndOrientation(
-                body, position.tolist(), quat.tolist(), physicsClientId=sim.client_id
-            )
-            p.resetBaseVelocity(body, [0, 0, 0], [0, 0, 0], physicsClientId=sim.client_id)
+            centre = make_transform((0.0, 0.0, labware.height / 2 + 0.0005))
+            position, quat = to_pose(T_world_site @ centre)
+            _teleport(sim, sim.scene.plates[plate.labware_id], position.tolist(), quat.tolist())
             self.faulted.discard(plate.labware_id)
             log.info("plate %s restored to %s/%d", plate.labware_id, plate.station, plate.sub_position)
 
