@@ -17,13 +17,11 @@ from __future__ import annotations
 
 import argparse
 import logging
-import signal
 import sys
 import time
 from pathlib import Path
 from typing import Any
 
-import rclpy
 import yaml
 from action_msgs.msg import GoalStatus
 from labware_interfaces.action import (
@@ -38,12 +36,12 @@ from labware_interfaces.action import (
 from labware_interfaces.msg import ErrorCodes, RobotState, StationStates
 from labware_interfaces.srv import DescribeWorkcell
 from rclpy.action import ActionClient, ActionServer, CancelResponse, GoalResponse
-from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
-from rclpy.signals import SignalHandlerOptions
 from rclpy.task import Future
 
+from tiago_sim.node_main import spin_node
 from tiago_sim.task_plans import Step, TaskRefused, Workcell, get_plan, put_plan
 
 log = logging.getLogger("tiago_sim.sequencer")
@@ -329,32 +327,13 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     logging.basicConfig(level=args.log_level, format="%(asctime)s %(levelname)s %(name)s: %(message)s")
     params = load_params(args.params)
-    rclpy.init(args=None, signal_handler_options=SignalHandlerOptions.NO)
-    node = rclpy.create_node("labware_sequencer")
-    executor = SingleThreadedExecutor()
-    executor.add_node(node)
-    stopping = False
 
-    def request_stop(signum: int, _frame: Any) -> None:
-        nonlocal stopping
-        log.info("signal %d: shutting down", signum)
-        stopping = True
-
-    signal.signal(signal.SIGINT, request_stop)
-    signal.signal(signal.SIGTERM, request_stop)
-    try:
-        Sequencer(node, params)
+    def build(node: Node) -> Sequencer:
+        sequencer = Sequencer(node, params)
         log.info("sequencer ready")
-        while not stopping and rclpy.ok():
-            executor.spin_once(timeout_sec=0.1)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        executor.shutdown(timeout_sec=1.0)
-        node.destroy_node()
-        if rclpy.ok():
-            rclpy.shutdown()
-    return 0
+        return sequencer
+
+    return spin_node("labware_sequencer", SingleThreadedExecutor, build)
 
 
 if __name__ == "__main__":

@@ -22,23 +22,21 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import logging
-import signal
 import sys
 from pathlib import Path
 from typing import Any
 
-import rclpy
 from labware_interfaces.msg import StationInfo
 from labware_interfaces.srv import CheckPlacement, DescribeWorkcell
 from rcl_interfaces.msg import SetParametersResult
-from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.signals import SignalHandlerOptions
 
 from tiago_sim.fault_injection import Occluders, PlateFaults
 from tiago_sim.marker_motion import MarkerMotionBehaviour
 from tiago_sim.motion_library import DEFAULT_MOTIONS_FILE, load_motions
+from tiago_sim.node_main import spin_node
 from tiago_sim.robot_behaviours import RobotBehaviours
 from tiago_sim.ros_actions import RobotActionServers
 from tiago_sim.ros_publishers import StatePublishers
@@ -263,34 +261,16 @@ def main(argv: list[str] | None = None) -> int:
     sim_thread = SimThread(
         lambda: make_simulation(Simulation, world, args), realtime_factor_cap=args.realtime_factor_cap
     )
-    rclpy.init(args=None, signal_handler_options=SignalHandlerOptions.NO)
-    node = rclpy.create_node("tiago_sim")
-    executor = MultiThreadedExecutor(num_threads=8)
-    stopping = False
 
-    def request_stop(signum: int, _frame: Any) -> None:
-        nonlocal stopping
-        log.info("signal %d: shutting down", signum)
-        stopping = True
-
-    signal.signal(signal.SIGINT, request_stop)
-    signal.signal(signal.SIGTERM, request_stop)
-    try:
+    def build(node: Node) -> SimNode:
         sim_thread.start()
-        SimNode(node, robot_world(world, args), sim_thread, args.motions)
-        executor.add_node(node)
+        sim_node = SimNode(node, robot_world(world, args), sim_thread, args.motions)
         log.info("sim node ready: world %s, %d stations", world.source, len(world.stations))
-        while not stopping and rclpy.ok():
-            executor.spin_once(timeout_sec=0.1)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        sim_thread.stop()
-        executor.shutdown(timeout_sec=1.0)
-        node.destroy_node()
-        if rclpy.ok():
-            rclpy.shutdown()
-    return 0
+        return sim_node
+
+    return spin_node(
+        "tiago_sim", lambda: MultiThreadedExecutor(num_threads=8), build, before_shutdown=sim_thread.stop
+    )
 
 
 if __name__ == "__main__":

@@ -1,0 +1,64 @@
+"""The main loop every robot-side process shares: one rclpy node spun until SIGINT or SIGTERM.
+
+Why: the sim node and the sequencer start, spin and stop the same way (signals set a flag so a
+stopped node exits quietly instead of raising ExternalShutdownException mid-callback); one copy
+keeps their shutdown order alike. Lives on: the process's main thread.
+"""
+
+from __future__ import annotations
+
+import logging
+import signal
+from collections.abc import Callable
+from typing import Any
+
+import rclpy
+from rclpy.executors import Executor, ExternalShutdownException
+from rclpy.node import Node
+from rclpy.signals import SignalHandlerOptions
+
+log = logging.getLogger(__name__)
+
+
+def spin_node(
+    node_name: str,
+    make_executor: Callable[[], Executor],
+    build: Callable[[Node], Any],
+    *,
+    before_shutdown: Callable[[], None] | None = None,
+) -> int:
+    """Create ``node_name``, ``build(node)`` its parts, spin until a signal, then tear down.
+
+    ``make_executor`` is called after rclpy.init (an executor needs the initialised context);
+    ``build`` may return the object that owns the node's callbacks (kept alive while spinning);
+    ``before_shutdown`` runs first on the way out (e.g. stopping a worker thread).
+    """
+    rclpy.init(args=None, signal_handler_options=SignalHandlerOptions.NO)
+    node = rclpy.create_node(node_name)
+    executor = make_executor()
+    stopping = False
+
+    def request_stop(signum: int, _frame: Any) -> None:
+        nonlocal stopping
+        log.info("signal %d: shutting down", signum)
+        stopping = True
+
+    signal.signal(signal.SIGINT, request_stop)
+    signal.signal(signal.SIGTERM, request_stop)
+    owner = None
+    try:
+        owner = build(node)
+        executor.add_node(node)
+        while not stopping and rclpy.ok():
+            executor.spin_once(timeout_sec=0.1)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        if before_shutdown is not None:
+            before_shutdown()
+        executor.shutdown(timeout_sec=1.0)
+        node.destroy_node()
+        if rclpy.ok():
+            rclpy.shutdown()
+        del owner
+    return 0
