@@ -8,7 +8,9 @@ and throttles to `idle_realtime_factor` while idle, so an idle node does not bur
 
 from __future__ import annotations
 
+import cProfile
 import logging
+import os
 import queue
 import threading
 import time
@@ -19,6 +21,9 @@ from typing import Any, TypeVar
 log = logging.getLogger(__name__)
 
 T = TypeVar("T")
+
+# Set to a file path to write a cProfile of the sim thread there when it stops (profiling runs only).
+PROFILE_ENV = "TIAGO_SIM_PROFILE"
 
 # While busy, run queued jobs after at most this many steps so ROS callbacks stay responsive.
 _STEPS_BETWEEN_JOB_CHECKS = 24
@@ -42,7 +47,7 @@ class SimThread:
         self.idle_realtime_factor = idle_realtime_factor
         self.sim_time = 0.0  # copy of sim.sim_time, readable from any thread
         self.steps = 0
-        self._thread = threading.Thread(target=self._run, name="sim", daemon=True)
+        self._thread = threading.Thread(target=self._run_maybe_profiled, name="sim", daemon=True)
 
     def start(self, timeout_s: float = 60.0) -> None:
         """Start the thread and wait until the Simulation is built (raises its error if not)."""
@@ -82,6 +87,20 @@ class SimThread:
                 future.set_result(job(sim))
             except BaseException as error:  # noqa: BLE001 - handed to the waiting thread
                 future.set_exception(error)
+
+    def _run_maybe_profiled(self) -> None:
+        profile_path = os.environ.get(PROFILE_ENV)
+        if not profile_path:
+            self._run()
+            return
+        profiler = cProfile.Profile()
+        profiler.enable()
+        try:
+            self._run()
+        finally:
+            profiler.disable()
+            profiler.dump_stats(profile_path)
+            log.info("sim thread profile written to %s", profile_path)
 
     def _run(self) -> None:
         try:
