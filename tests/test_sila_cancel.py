@@ -1,0 +1,91 @@
+"""Cancelling a running GetLabware from a SiLA client.
+
+How a client cancels here: sila2 0.14 ships no CancelController (the SiLA core feature is not in
+its `sila2.features`, and its servers have no hook to interrupt a running command instance), so
+the robot's own unobservable command MobileRobotController.StopMotion is the cancel: it cancels
+whatever ROS goal the robot runs, GetLabware's included. The sequencer stops the running
+sub-action safely and reports CANCELED; GetLabware then ends with its defined error
+LabwareNotPicked naming the cancel, after the inventory was settled from the robot's observations.
+
+Consistency is checked against physics ground truth (the simulation's CheckPlacement), and a
+complete transfer must then succeed from wherever the plate is.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterator
+
+import pytest
+from sila2.framework import DefinedExecutionError
+from sila_stack import start_stack
+from transfer_steps import Cell, finish
+
+PLATE = "plate_001"
+A1, B1 = ("station_a", 1), ("station_b", 1)
+CANCEL_AT_PROGRESS = 0.03
+"""Early in the manipulation (the arm going to the bench), so the cancel lands mid-command."""
+
+
+@pytest.fixture(scope="module")
+def cell(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Cell]:
+    deployment = start_stack(tmp_path_factory.mktemp("cancel"), insecure=True)
+    yield Cell(deployment)
+    deployment.stop()
+
+
+def physical_location(cell: Cell) -> str:
+    """Where the simulation says the plate is: station:<name>:<sub>, hotel:<slot>, gripper, floor."""
+    assert cell.deployment.link is not None
+    return cell.deployment.link.check_placement(PLATE).location
+
+
+def reported_location(cell: Cell) -> str:
+    """Where the robot server's inventory says the plate is, in the same notation."""
+    aboard, station, index = cell.location(PLATE)
+    if not aboard:
+        return f"station:{station}:{index}"
+    onboard = cell.robot.MobileRobotController.OnboardLabware.get()
+    slots = [item.InternalPosition for item in onboard if item.LabwareUniqueID == PLATE]
+    return f"hotel:{slots[0]}" if slots else "gripper"
+
+
+def test_stop_motion_cancels_get_labware_and_everything_stays_consistent(cell: Cell) -> None:
+    cell.prepare_pick(A1, PLATE)
+    get = cell.manipulator.GetLabware(HandoverPosition=A1, IntermediateActions=[])
+    deadline = time.monotonic() + 60.0
+    while (get.progress or 0.0) < CANCEL_AT_PROGRESS:
+        assert not get.done, "GetLabware ended before it could be cancelled"
+        assert time.monotonic() < deadline, f"GetLabware made no progress: {get.progress}"
+        time.sleep(0.02)
+    assert cell.robot_state() == "Manipulating"
+
+    cell.robot.MobileRobotController.StopMotion()
+    stopped_at = time.monotonic()
+    with pytest.raises(DefinedExecutionError, match="CANCELED") as raised:
+        finish(get, timeout_s=30.0)
+    assert raised.value.identifier == "LabwareNotPicked", raised.value
+    assert time.monotonic() - stopped_at < 10.0
+
+    # The robot is at rest and not in error; a second StopMotion finds nothing to stop.
+    assert cell.robot_state() == "Idle"
+    cell.robot.MobileRobotController.StopMotion()
+
+    # Inventory matches physics: the plate is in the source nest, in the hotel or held.
+    where = physical_location(cell)
+    assert where in {"station:station_a:1", "hotel:1", "gripper"}, where
+    assert reported_location(cell) == where
+    occupied = cell.nest_occupied()
+    assert occupied[A1] == (where == "station:station_a:1")
+    assert not occupied[B1]
+
+    # A complete transfer follows. Station A is still prepared for output (its handover is open),
+    # so the scheduler redoes the robot's part, then closes A and places in B.
+    assert where == "station:station_a:1", f"cancel landed after the grasp: plate at {where}"
+    cell.prepare_pick(A1, PLATE, station_too=False)
+    cell.pick(A1)
+    cell.place(B1, PLATE)
+    assert physical_location(cell) == "station:station_b:1"
+    assert reported_location(cell) == "station:station_b:1"
+    assert cell.deployment.link is not None
+    assert cell.deployment.link.check_placement(PLATE, *B1).in_nest
