@@ -131,8 +131,13 @@ def outcome_of(command: str, call: Callable[[], Any], *, may_succeed: bool = Fal
         kind = "ok"
     except DefinedExecutionError as error:
         kind = f"defined:{error.identifier}"
-    except ValidationError:
+    except ValidationError as error:
+        # The server names the parameter; the sila2 client refuses a feature constraint itself.
+        named = error.parameter_fully_qualified_identifier is not None
+        assert named or "Constraint violated" in error.message, f"{command}: unnamed {error.message}"
         kind = "validation"
+        OUTCOMES[f"{command} validation by {'server' if named else 'client'}"] += 1
+        return kind
     except concurrent.futures.TimeoutError:
         pytest.fail(f"{command}: no answer within {CALL_DEADLINE_S:.0f} s")
     except Exception as error:  # noqa: BLE001 - the point: anything else is a finding
