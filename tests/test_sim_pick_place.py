@@ -68,7 +68,9 @@ class Script:
         assert self.sim.held_labware(ARM) == ""
 
     def drive(self, poi: str) -> None:
-        goal = self.sim.world.pois[poi]
+        """To a station's working pose (where the marker-guided final approach ends), else to the POI."""
+        stations = {station.poi: station for station in self.sim.world.stations}
+        goal = stations[poi].aligned_pose() if poi in stations else self.sim.world.pois[poi]
         self.run(self.sim.drive_to(goal.x, goal.y, goal.yaw), f"drive to {poi}")
 
     def site_in_base(self, station: str, sub: int) -> np.ndarray:

@@ -88,7 +88,9 @@ def test_moving_a_station_is_a_yaml_edit(tmp_path):
     site = station.T_world_site(1)
     T_base_site = tf.invert(world.pois[station.poi].matrix()) @ site
     assert math.degrees(world.pois[station.poi].yaw) == pytest.approx(45.0)
-    assert T_base_site[0, 3] == pytest.approx(0.5, abs=1e-6)
+    assert T_base_site[0, 3] == pytest.approx(0.62, abs=1e-6)  # navigation stops at the standoff
+    T_work_site = tf.invert(station.aligned_pose().matrix()) @ site
+    assert T_work_site[0, 3] == pytest.approx(0.5, abs=1e-6)  # the final approach ends at work_standoff
 
 
 def test_head_camera_and_arm_frames_match_the_tiago_figures():

@@ -5,6 +5,9 @@ camera's pixels and depth, its joint readings and its kinematic model. The marke
 perception.detect_marker on the rendered image; the camera pose in base_footprint from forward
 kinematics of the joint readings taken with the image; never from simulator link states.
 
+Target "work_pose" moves the base instead (tiago_sim.base_alignment): from the station's POI to
+the working pose in front of the nests, as the marker shows it.
+
 Steps: take an image (sim thread) -> detect the marker (this thread) -> T_base_marker =
 T_base_optical @ T_optical_marker -> the nest frame from the world's site_in_marker, sub-position
 spacing and approach height -> the grasp pose in that frame (fingers down, closing across the
@@ -26,6 +29,7 @@ from geometry_msgs.msg import Pose
 from labware_interfaces.msg import ErrorCodes
 
 from tiago_sim.action_run import ActionAbort, ActionRun
+from tiago_sim.base_alignment import align_base
 from tiago_sim.kinematics import RobotKinematics
 from tiago_sim.motion_library import HotelGrasp
 from tiago_sim.perception.aruco import detect_marker
@@ -35,7 +39,7 @@ from tiago_sim.world import World
 
 log = logging.getLogger(__name__)
 
-TARGETS = ("site_approach", "site")
+TARGETS = ("site_approach", "site", "work_pose")
 CAMERA_FRAME = "head_camera_optical_frame"
 # A cached marker stays valid while odometry moved less than this.
 SAME_BASE_POSITION_M = 0.002
@@ -130,6 +134,13 @@ class MarkerMotionBehaviour:
                 ErrorCodes.BAD_GOAL,
                 f"station {station.name} has sub-positions 1..{station.sub_positions}, not {sub_position}",
             )
+        if goal.target == "work_pose":  # final approach of the base, guided by the marker
+            bench = self.behaviours.motions.frames_for("Benchtop", arm)[0]
+            posture = {name: value for name, value in bench.items() if not name.startswith("arm_")}
+            sighting = align_base(
+                run, station, self.kinematics, lambda r: self.look(r, station.name), posture
+            )
+            return {"marker_in_base": pose_msg(sighting.T_base_marker)}
         sighting = self._cached(run, station.name)
         if sighting is None:
             sighting = self.look(run, station.name)
@@ -144,8 +155,16 @@ class MarkerMotionBehaviour:
         T_base_target = self.behaviours.grasp_twin(arm, T_base_grasp, seed)
         in_nest = goal.target == "site"  # slow only where the plate enters or leaves the nest
         speed = TOOL_SPEED_INTO_POCKET if in_nest else TOOL_SPEED_FREE
+        # From the hotel (PutLabware): straight up to the carry height, then straight to the bench.
+        # The sighting taken at the end of the final approach stays valid: the base has not moved.
+        first = 0.1 if in_nest else max(0.1, self.behaviours.leave_hotel(run, arm))
         try:
-            run.run_motion(lambda sim: sim.move_tool(arm, T_base_target, True, speed), span=(0.1, 1.0))
+            try:
+                run.run_motion(lambda sim: sim.move_tool(arm, T_base_target, True, speed), span=(first, 1.0))
+            except ActionAbort as abort:
+                if first <= 0.1 or abort.code != ErrorCodes.IK_FAILED:
+                    raise
+                self.behaviours.joint_space_move(run, arm, T_base_target, (first, 1.0))
         except ActionAbort as abort:
             abort.extra = {"marker_in_base": marker_in_base}
             raise

@@ -29,7 +29,7 @@ log = logging.getLogger(__name__)
 # Straight tool moves (m/s along the line; joint limits cap them too): slow where the plate enters a
 # nest or hotel pocket, where chamfers guide it; faster in free space (approach, lift, carry).
 TOOL_SPEED_INTO_POCKET = 0.08
-TOOL_SPEED_FREE = 0.08  # 0.15 lost the plate on the return trip of test_ros_transfer (see report)
+TOOL_SPEED_FREE = 0.25
 
 # Half-turn about the grasp x axis: the same top-down grasp with the fingers swapped.
 FLIP_ABOUT_APPROACH = make_transform(rotation=np.diag([1.0, -1.0, -1.0]))
@@ -84,8 +84,26 @@ class RobotBehaviours:
             )
         if run.sim(lambda sim: sim.is_docked()):
             raise ActionAbort(ErrorCodes.DOCKED, "the robot is docked: undock first")
+        lowering = self._lower_torso(run)
         run.run_motion(lambda sim: sim.drive_to(*pose))
+        if lowering is not None:
+            run.run_motion(lambda _sim: lowering)
         return {}
+
+    def _lower_torso(self, run: ActionRun) -> Any:
+        """Start the torso down to the travel height of "Home" (it runs while the base drives)."""
+        travel = [
+            frame["torso_lift_joint"]
+            for frame in self.motions.keyframes.get("Home", [])
+            if "torso_lift_joint" in frame
+        ]
+        if not travel:
+            return None
+        height = run.sim(lambda sim: sim.joint_positions()["torso_lift_joint"])
+        if height <= travel[-1] + 0.01:
+            return None
+        speed = self.speed_scale() * self.motions.speed_scale
+        return run.sim(lambda sim: sim.move_joints({"torso_lift_joint": travel[-1]}, speed))
 
     def dock(self, run: ActionRun, _goal: Any) -> dict:
         if run.sim(lambda sim: sim.is_docked()):
@@ -117,8 +135,8 @@ class RobotBehaviours:
         self.on_keyframe_motion()
         frames = self.motions.frames_for(name, arm)
         first = 0.0
-        if name != "Home":
-            first = self._leave_hotel(run, arm)  # never sweep a held plate through the hotel
+        if name not in ("Home", "Tuck"):
+            first = self.leave_hotel(run, arm)  # never sweep a held plate through the hotel
         speed = self.speed_scale() * self.motions.speed_scale
         for index, targets in enumerate(frames):
             span = (
@@ -182,14 +200,34 @@ class RobotBehaviours:
         except ActionAbort as abort:
             if not free or abort.code != ErrorCodes.IK_FAILED:
                 raise
-            log.info("no straight path to %s: moving in joint space", np.round(target[:3, 3], 3))
-            run.run_motion(lambda sim: sim.move_tool(arm, target, False, tool_speed), span=span)
+            self.joint_space_move(run, arm, target, span)
+
+    def joint_space_move(
+        self, run: ActionRun, arm: str, T_base_grasp: np.ndarray, span: tuple[float, float]
+    ) -> None:
+        """Where no straight tool path exists (e.g. from the folded arm): one joint-space move.
+
+        The arm alone first (the torso lifts at only 0.07 m/s and would set the pace), the torso too
+        only if the arm alone cannot reach; 60 seeded IK restarts rather than the simulator's 30
+        (seed 111: those found no solution for the hotel from the tucked arm).
+        """
+        log.info("no straight path to %s: moving in joint space", np.round(T_base_grasp[:3, 3], 3))
+        seed = run.sim(lambda sim: dict(sim.joint_positions()))
+        joints = self.solve_ik(arm, T_base_grasp, seed, use_torso=False) or self.solve_ik(
+            arm, T_base_grasp, seed
+        )
+        if joints is None:
+            raise ActionAbort(
+                ErrorCodes.IK_FAILED, f"the {arm} arm cannot reach {np.round(T_base_grasp[:3, 3], 3)}"
+            )
+        speed = self.speed_scale() * self.motions.speed_scale
+        run.run_motion(lambda sim: sim.move_joints(joints, speed), span=span)
 
     def _over_slot(self, arm: str, joints: dict[str, float], slot: int, radius_m: float) -> bool:
         tool = self.tool_pose(arm, joints)[:3, 3]
         return float(np.hypot(*(tool[:2] - self.hotel_grasp_pose(slot, True)[:2, 3]))) < radius_m
 
-    def _leave_hotel(self, run: ActionRun, arm: str) -> float:
+    def leave_hotel(self, run: ActionRun, arm: str) -> float:
         """If the tool is over a hotel slot, rise straight to the carry height; returns progress used."""
         joints = run.sim(lambda sim: dict(sim.joint_positions()))
         for slot in range(1, self.hotel_slots + 1):

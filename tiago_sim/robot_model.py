@@ -59,7 +59,9 @@ TOOL_TO_GRASP = 0.1506 + 0.12
 # Hotel (onboard plate holder): pocket floors on the base front, reachable top-down by either arm
 HOTEL_SLOT_XYZ = ((0.25, -0.07, 0.60), (0.25, 0.07, 0.60))
 HOTEL_POCKET_SIZE = (0.1318, 0.0895)  # inner length x width, 2 mm clearance per side
-HOTEL_WALL_HEIGHT = 0.008
+HOTEL_WALL_HEIGHT = 0.004  # vertical part at the pocket edge; the lead-in chamfer sits on top (rim 10 mm)
+HOTEL_LEAD_IN = 0.006  # per side, 45 deg chamfers on the corner posts: a plate carried a few mm off
+# centre in the gripper slides into the pocket instead of resting on a post (seed 102 of the campaign)
 
 
 @dataclass(frozen=True)
@@ -323,7 +325,30 @@ def _corner_brackets(x: float, y: float, z: float, length: float, width: float):
     return [
         ("box", size, (x + cx, y + cy, z + cz), (0, 0, 0), "dark")
         for size, (cx, cy, cz) in corner_bracket_boxes(length, width, HOTEL_WALL_HEIGHT)
-    ]
+    ] + _lead_ins(x, y, z, length, width)
+
+
+def _lead_ins(
+    x: float, y: float, z: float, length: float, width: float, leg: float = 0.015, wall: float = 0.006
+):
+    """45 deg chamfer plates on top of the corner posts, widening the opening by HOTEL_LEAD_IN per side."""
+    lead, thick, top = HOTEL_LEAD_IN, 0.003, z + HOTEL_WALL_HEIGHT
+    slope = lead * math.sqrt(2.0)
+    inset = thick / 2 / math.sqrt(2.0)  # the plate's lower face meets the wall's top edge
+    shapes = []
+    for cx in (-1, 1):
+        for cy in (-1, 1):
+            across = (x + cx * (length / 2 + lead / 2 + inset), y + cy * (width / 2 - leg / 2 + wall / 2))
+            shapes.append(
+                ("box", (slope, leg + wall, thick), (*across, top + lead / 2 - inset),
+                 (0, -math.pi / 4 if cx > 0 else -3 * math.pi / 4, 0), "dark")
+            )  # fmt: skip
+            along = (x + cx * (length / 2 - leg / 2), y + cy * (width / 2 + lead / 2 + inset))
+            shapes.append(
+                ("box", (leg, slope, thick), (*along, top + lead / 2 - inset),
+                 (math.pi / 4 if cy > 0 else 3 * math.pi / 4, 0, 0), "dark")
+            )  # fmt: skip
+    return shapes
 
 
 def _add_hotel(w: UrdfWriter) -> None:

@@ -78,10 +78,12 @@ def hotel_slot(robot_state: Any, index: int) -> Any | None:
 
 
 def travel_steps(robot_state: Any, poi: str) -> list[Step]:
-    """Arm home, off the dock, drive to the station's POI - whatever of it is needed."""
+    """Arm tucked, off the dock, drive to the station's POI - whatever of it is needed.
+
+    The torso goes down to the travel height during the drive (navigate overlaps the two)."""
     if robot_state.current_poi == poi and robot_state.state != RobotState.STATE_DOCKED:
         return []
-    steps = [Step("play_motion", {"motion_name": "Home"}, "arm home")]
+    steps = [Step("play_motion", {"motion_name": "Tuck"}, "arm tucked")]
     if robot_state.state == RobotState.STATE_DOCKED:
         steps.append(Step("undock", {}, "undocking"))
     steps.append(Step("navigate", {"poi": poi}, "driving"))
@@ -105,6 +107,7 @@ def get_plan(goal: Any, workcell: Workcell, robot_state: Any, station_states: An
     hotel = {"hotel_slot": goal.internal_position, "arm": arm}
     return [
         *travel_steps(robot_state, poi),
+        Step("marker_motion", {**site, "target": "work_pose"}, "final approach"),
         Step("play_motion", {"motion_name": "Benchtop", "arm": arm}, "arm to bench"),
         Step("gripper", {"command": "open", "arm": arm}, "opening"),
         Step("marker_motion", {**site, "target": "site_approach"}, "approach"),
@@ -115,7 +118,7 @@ def get_plan(goal: Any, workcell: Workcell, robot_state: Any, station_states: An
         Step("play_motion", {"motion_name": "Nest", **hotel}, "into hotel"),
         Step("gripper", {"command": "open", "arm": arm}, "release"),
         Step("play_motion", {"motion_name": "NestApproach", **hotel}, "retract"),
-        Step("play_motion", {"motion_name": "Home", "arm": arm}, "arm home"),
+        Step("play_motion", {"motion_name": "Tuck", "arm": arm}, "arm tucked"),
     ]
 
 
@@ -136,15 +139,15 @@ def put_plan(goal: Any, workcell: Workcell, robot_state: Any, station_states: An
     hotel = {"hotel_slot": goal.internal_position, "arm": arm}
     return [
         *travel_steps(robot_state, poi),
+        Step("marker_motion", {**site, "target": "work_pose"}, "final approach"),
         Step("gripper", {"command": "open", "arm": arm}, "opening"),
         Step("play_motion", {"motion_name": "NestApproach", **hotel}, "to hotel"),
         Step("play_motion", {"motion_name": "Nest", **hotel}, "into hotel"),
         Step("gripper", {"command": "close", "arm": arm}, "grasp", expect_holding=True),
         Step("play_motion", {"motion_name": "NestApproach", **hotel}, "lifting"),
-        Step("play_motion", {"motion_name": "Benchtop", "arm": arm}, "arm to bench"),
-        Step("marker_motion", {**site, "target": "site_approach"}, "approach"),
+        Step("marker_motion", {**site, "target": "site_approach"}, "approach"),  # via the carry height
         Step("marker_motion", {**site, "target": "site"}, "placing"),
         Step("gripper", {"command": "open", "arm": arm}, "release"),
         Step("marker_motion", {**site, "target": "site_approach"}, "retract"),
-        Step("play_motion", {"motion_name": "Home", "arm": arm}, "arm home"),
+        Step("play_motion", {"motion_name": "Tuck", "arm": arm}, "arm tucked"),
     ]

@@ -64,7 +64,7 @@ class UrdfWriter:
             if collide:
                 body.append(f"<collision>{origin}<geometry>{geometry}</geometry></collision>")
         body.append("</link>")
-        self.parts.append("".join(body))
+        self.parts.append("\n".join(body))  # PyBullet rejects URDF lines over ~10k characters
 
     def joint(
         self, name: str, kind: str, parent: str, child: str, xyz=(0, 0, 0), rpy=(0, 0, 0), **opts

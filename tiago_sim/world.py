@@ -69,9 +69,10 @@ class Station:
     spacing: float  # between sub-positions along the site x axis
     nest_clearance: float  # per side, between plate and nest walls
     poi: str
-    standoff: float  # base_footprint this far in front of the middle of the nest row
+    standoff: float  # navigation stops base_footprint this far in front of the middle of the nest row
     lateral: float  # and this far to the side, so the site lies on the working arm's side
     approach_height: float  # site_approach is this far above the site
+    work_standoff: float = 0.0  # the marker-guided final approach ends this close (0: same as standoff)
 
     def T_world_table(self) -> np.ndarray:
         return self.table_pose.matrix(self.table_size[2])
@@ -96,7 +97,16 @@ class Station:
         return self.T_world_marker() @ self.T_marker_site(sub_position)
 
     def work_pose(self) -> Pose2D:
-        """Where base_footprint stands to work: facing the nests, ``standoff`` in front of their middle."""
+        """Where navigation brings base_footprint (the POI): facing the nests, ``standoff`` in front of
+        their middle, far enough from the table that a navigation error never makes the base touch it."""
+        return self._pose_in_front(self.standoff)
+
+    def aligned_pose(self) -> Pose2D:
+        """Where base_footprint works: ``work_standoff`` in front of the nests, reached from the POI by
+        a short drive guided by the station's marker."""
+        return self._pose_in_front(self.work_standoff or self.standoff)
+
+    def _pose_in_front(self, standoff: float) -> Pose2D:
         middle = (
             self.T_world_marker()
             @ self.T_marker_site(1)
@@ -105,7 +115,7 @@ class Station:
         facing = tf.yaw_of(self.T_world_table())
         forward = np.array([math.cos(facing), math.sin(facing)])
         left = np.array([-forward[1], forward[0]])
-        xy = middle[:2, 3] - self.standoff * forward + self.lateral * left
+        xy = middle[:2, 3] - standoff * forward + self.lateral * left
         return Pose2D(float(xy[0]), float(xy[1]), facing)
 
 
@@ -240,6 +250,7 @@ def _read_station(r: _Reader, raw: Any, where: str) -> Station:
         standoff=standoff,
         lateral=r.number(poi, "lateral", f"{where}.poi", -0.5, 0.5, default=0.0),
         approach_height=r.number(nests, "approach_height", f"{where}.nests", 0.02, 0.4, default=0.1),
+        work_standoff=r.number(poi, "work_standoff", f"{where}.poi", 0.3, 1.0, default=standoff),
     )
 
 
