@@ -58,11 +58,14 @@ def set_fault(cell: Cell, name: str, value: str) -> None:
     set_node_parameter(cell.deployment.runtime, name, value)
 
 
+def sim_log(cell: Cell) -> str:
+    assert cell.deployment.options.log_dir is not None
+    return (cell.deployment.options.log_dir / "sim_node.log").read_text(errors="replace")
+
+
 def goal_lines(cell: Cell) -> list[str]:
     """The sim node's one log line per robot-level goal (name, outcome, simulated span)."""
-    assert cell.deployment.options.log_dir is not None
-    log = (cell.deployment.options.log_dir / "sim_node.log").read_text(errors="replace")
-    return [line for line in log.splitlines() if ": sim " in line and " .. " in line]
+    return [line for line in sim_log(cell).splitlines() if ": sim " in line and " .. " in line]
 
 
 def expect_error(identifier: str, instance_or_call, match: str) -> DefinedExecutionError:
@@ -159,6 +162,7 @@ def test_plate_dropped_mid_drive_is_labware_not_placed_and_reported_lost(cell: C
         )
         put = cell.manipulator.PutLabware(HandoverPosition=B1, IntermediateActions=[])
         expect_error("LabwareNotPlaced", put, "SLOT_EMPTY")
+        assert f"plate {PLATE} slipped out of hotel slot 1 mid-drive" in sim_log(cell)
         assert_lost(cell, PLATE)
         assert cell.deployment.link is not None
         truth = cell.deployment.link.check_placement(PLATE, "", 0)  # ground truth, for the check only
