@@ -73,6 +73,10 @@ def align_base(
     T_world_poi = station.work_pose().matrix()  # where the robot believes navigation left it
     T_base_marker_expected = tf.invert(T_world_poi) @ station.T_world_marker()
     head = head_angles_towards(kinematics, joints, T_base_marker_expected[:3, 3])
+    # The torso starts rising at once (it is the slowest joint); the image is taken with the joint
+    # readings of the same instant, so the camera pose stays exact while it moves.
+    torso = {name: value for name, value in working_joints.items() if name not in HEAD_JOINTS}
+    lifting = run.sim(lambda sim: sim.move_joints(torso)) if torso else None
     run.run_motion(lambda sim: sim.move_joints(head), span=(0.0, 0.15))
     sighting = look(run)
     T_marker_work = tf.invert(station.T_world_marker()) @ station.aligned_pose().matrix()
@@ -83,8 +87,10 @@ def align_base(
         "aligning at %s: working pose at x %.3f y %.3f m, yaw %.1f deg from here",
         station.name, correction[0], correction[1], math.degrees(correction[2]),
     )  # fmt: skip
-    posture = run.sim(lambda sim: sim.move_joints(working_joints)) if working_joints else None
+    head_at_work = {name: value for name, value in working_joints.items() if name in HEAD_JOINTS}
+    turning = run.sim(lambda sim: sim.move_joints(head_at_work)) if head_at_work else None
     run.run_motion(lambda sim: sim.drive_to(*goal, speed=ALIGN_SPEED), span=(0.2, 0.9))
-    if posture is not None:
-        run.run_motion(lambda _sim: posture, span=(0.9, 1.0))
+    for motion in (lifting, turning):
+        if motion is not None:
+            run.run_motion(lambda _sim, motion=motion: motion, span=(0.9, 1.0))
     return look(run)  # from the working pose: later tool moves reuse it while the base stands

@@ -20,6 +20,7 @@ from tiago_sim.robot_body import RobotBody
 POSITION_TOLERANCE = 0.01  # m
 YAW_TOLERANCE = 0.01  # rad
 HEADING_GAIN = 2.5
+BLEND_ANGLE = 0.3  # rad: the drive starts once the heading is this close; the heading loop finishes the turn
 
 
 def wrap_angle(angle: float) -> float:
@@ -170,8 +171,10 @@ class DriveMotion(Motion):
         if self.phase == "turning":
             error = self._heading_error() if distance > POSITION_TOLERANCE * 2 else 0.0
             base.command(0.0, self._turn_rate(error))
-            if abs(error) < 0.02 and abs(base.w) < 0.05:
-                self.phase = "driving" if distance > POSITION_TOLERANCE * 2 else "aligning"
+            if distance > POSITION_TOLERANCE * 2 and abs(error) < BLEND_ANGLE:
+                self.phase = "driving"  # v ramps up from rest while the heading loop closes the error
+            elif abs(error) < 0.02 and abs(base.w) < 0.05:
+                self.phase = "aligning"
         elif self.phase == "driving":
             direction = -1.0 if self.reverse else 1.0
             heading_error = self._heading_error()

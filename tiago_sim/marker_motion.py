@@ -159,8 +159,11 @@ class MarkerMotionBehaviour:
         # The sighting taken at the end of the final approach stays valid: the base has not moved.
         first = 0.1 if in_nest else max(0.1, self.behaviours.leave_hotel(run, arm))
         try:
+            if in_nest:
+                self.behaviours.into_pocket(run, arm, T_base_target, (first, 1.0))
+                return {"marker_in_base": marker_in_base}
             try:
-                run.run_motion(lambda sim: sim.move_tool(arm, T_base_target, True, speed), span=(first, 1.0))
+                self.behaviours.straight_move(run, arm, T_base_target, speed, (first, 1.0))
             except ActionAbort as abort:
                 if first <= 0.1 or abort.code != ErrorCodes.IK_FAILED:
                     raise

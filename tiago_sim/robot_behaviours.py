@@ -30,6 +30,7 @@ log = logging.getLogger(__name__)
 # nest or hotel pocket, where chamfers guide it; faster in free space (approach, lift, carry).
 TOOL_SPEED_INTO_POCKET = 0.08
 TOOL_SPEED_FREE = 0.25
+CREEP_HEIGHT = 0.025  # m above a pocket where the slow creep starts (the chamfers are 6 to 10 mm tall)
 
 # Half-turn about the grasp x axis: the same top-down grasp with the fingers swapped.
 FLIP_ABOUT_APPROACH = make_transform(rotation=np.diag([1.0, -1.0, -1.0]))
@@ -196,11 +197,39 @@ class RobotBehaviours:
         seed = run.sim(lambda sim: dict(sim.joint_positions()))
         target = self.grasp_twin(arm, T_base_grasp, seed)
         try:
-            run.run_motion(lambda sim: sim.move_tool(arm, target, True, tool_speed), span=span)
+            self.straight_move(run, arm, target, tool_speed, span)
         except ActionAbort as abort:
             if not free or abort.code != ErrorCodes.IK_FAILED:
                 raise
             self.joint_space_move(run, arm, target, span)
+
+    def into_pocket(
+        self, run: ActionRun, arm: str, T_base_grasp: np.ndarray, span: tuple[float, float]
+    ) -> None:
+        """Down into a nest or hotel pocket: fast to CREEP_HEIGHT above it, then slowly the rest."""
+        joints = run.sim(lambda sim: dict(sim.joint_positions()))
+        height = self.tool_pose(arm, joints)[2, 3] - T_base_grasp[2, 3]
+        low, high = span
+        if height > CREEP_HEIGHT + 0.01:
+            T_above = T_base_grasp.copy()
+            T_above[2, 3] += CREEP_HEIGHT
+            middle = low + (high - low) * 0.6
+            self.straight_move(run, arm, T_above, TOOL_SPEED_FREE, (low, middle))
+            low = middle
+        self.straight_move(run, arm, T_base_grasp, TOOL_SPEED_INTO_POCKET, (low, high))
+
+    def straight_move(
+        self, run: ActionRun, arm: str, T_base_grasp: np.ndarray, tool_speed: float, span: tuple[float, float]
+    ) -> None:
+        """Straight tool move by the arm alone if it can (the torso lifts at only 0.07 m/s and would
+        set the pace of every vertical move), else with the torso. A path that fails its IK check
+        fails before anything moves, so the second try starts from the same state."""
+        try:
+            run.run_motion(lambda sim: sim.move_tool(arm, T_base_grasp, True, tool_speed, False), span=span)
+        except ActionAbort as abort:
+            if abort.code != ErrorCodes.IK_FAILED:
+                raise
+            run.run_motion(lambda sim: sim.move_tool(arm, T_base_grasp, True, tool_speed, True), span=span)
 
     def joint_space_move(
         self, run: ActionRun, arm: str, T_base_grasp: np.ndarray, span: tuple[float, float]
@@ -234,10 +263,7 @@ class RobotBehaviours:
             if self._over_slot(arm, joints, slot, 0.05):
                 T_carry = self.tool_pose(arm, joints)
                 T_carry[2, 3] = self.hotel_grasp_pose(slot, True)[2, 3] + self.motions.hotel.carry_height_m
-                run.run_motion(
-                    lambda sim, target=T_carry: sim.move_tool(arm, target, True, TOOL_SPEED_FREE),
-                    span=(0.0, 0.3),
-                )
+                self.straight_move(run, arm, T_carry, TOOL_SPEED_FREE, (0.0, 0.3))
                 return 0.3
         return 0.0
 
@@ -245,7 +271,8 @@ class RobotBehaviours:
         T_approach = self.hotel_grasp_pose(slot, approach=True)
         if name == "Nest":  # straight down into the pocket (back up: NestApproach)
             T_nest = self.hotel_grasp_pose(slot, approach=False)
-            self._tool_move(run, arm, T_nest, (0.0, 1.0), tool_speed=TOOL_SPEED_INTO_POCKET)
+            seed = run.sim(lambda sim: dict(sim.joint_positions()))
+            self.into_pocket(run, arm, self.grasp_twin(arm, T_nest, seed), (0.0, 1.0))
             return
         joints = run.sim(lambda sim: dict(sim.joint_positions()))
         if self._over_slot(arm, joints, slot, 0.03):  # straight up or down to the approach pose

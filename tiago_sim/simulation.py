@@ -340,11 +340,17 @@ class Simulation:
         return name.split("_")[0]  # torso, head, wheel
 
     def move_tool(
-        self, arm: str, T_base_grasp: np.ndarray, straight_line: bool = True, tool_speed: float = TOOL_SPEED
+        self,
+        arm: str,
+        T_base_grasp: np.ndarray,
+        straight_line: bool = True,
+        tool_speed: float = TOOL_SPEED,
+        use_torso: bool = True,
     ) -> Motion:
         """Grasping frame of ``arm`` to a pose in base_footprint, via IK waypoints when straight.
 
         ``tool_speed`` (m/s) caps the speed along a straight line; the joint limits cap it too.
+        ``use_torso`` False keeps the torso still (it lifts at only 0.07 m/s and would set the pace).
         """
         if arm not in rm.ARM_SIDES:
             return FailedMotion("move_tool", "BAD_GOAL", f"unknown arm {arm!r}")
@@ -357,7 +363,12 @@ class Simulation:
         for index, T_waypoint in enumerate(waypoints):
             restarts = 30 if (index == 0 and not straight_line) else 3
             result = self.kinematics.inverse(
-                arm, T_waypoint, seed, use_torso=True, restarts=restarts, seed=int(self.rng.integers(1 << 30))
+                arm,
+                T_waypoint,
+                seed,
+                use_torso=use_torso,
+                restarts=restarts,
+                seed=int(self.rng.integers(1 << 30)),
             )
             jump = max(
                 (abs(result.joint_positions[n] - seed[n]) for n in result.joint_positions), default=0.0
@@ -365,7 +376,7 @@ class Simulation:
             if straight_line and (not result.success or jump > MAX_WAYPOINT_JUMP):
                 # near a joint limit the seeded solve can stall: creep there in small, seeded steps
                 T_previous = waypoints[index - 1] if index else T_start
-                result = self._creep(arm, T_previous, T_waypoint, seed) or result
+                result = self._creep(arm, T_previous, T_waypoint, seed, use_torso) or result
                 jump = max(
                     (abs(result.joint_positions[n] - seed[n]) for n in result.joint_positions), default=0.0
                 )
@@ -381,12 +392,16 @@ class Simulation:
         )
         return self._start(motion)
 
-    def _creep(self, arm: str, T_from: np.ndarray, T_to: np.ndarray, seed: dict[str, float]):
+    def _creep(
+        self, arm: str, T_from: np.ndarray, T_to: np.ndarray, seed: dict[str, float], use_torso: bool = True
+    ):
         """IK for T_to reached from T_from in seeded sub-steps (no random restarts), or None."""
         here = dict(seed)
         result = None
         for T_sub in _straight_path(T_from, T_to, step=STRAIGHT_STEP / 5):
-            result = self.kinematics.inverse(arm, T_sub, here, use_torso=True, restarts=0, max_iterations=400)
+            result = self.kinematics.inverse(
+                arm, T_sub, here, use_torso=use_torso, restarts=0, max_iterations=400
+            )
             if not result.success:
                 return None
             here.update(result.joint_positions)
