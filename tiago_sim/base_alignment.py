@@ -30,6 +30,7 @@ from tiago_sim.world import Station
 log = logging.getLogger(__name__)
 
 HEAD_JOINTS = ("head_1_joint", "head_2_joint")
+CAMERA_FRAME = "head_camera_optical_frame"
 ALIGN_SPEED = 0.3  # m/s cap for the short final drive (the acceleration limit keeps it lower anyway)
 
 
@@ -41,6 +42,11 @@ def head_angles_towards(kinematics: RobotKinematics, joints: dict[str, float], t
     tilt_origin = kinematics.forward({**level, "head_1_joint": pan}, "head_2_link")[:3, 3]
     horizontal = math.hypot(target[0] - tilt_origin[0], target[1] - tilt_origin[1])
     tilt = -math.atan2(tilt_origin[2] - target[2], horizontal)  # negative tilt looks down
+    for _ in range(3):  # the camera sits off both head axes: centre the target in the image
+        optical = kinematics.forward({**level, "head_1_joint": pan, "head_2_joint": tilt}, CAMERA_FRAME)
+        x, y, z = tf.invert(optical)[:3, :3] @ (target - optical[:3, 3])  # z ahead, x right, y down
+        pan -= math.atan2(x, z)
+        tilt -= math.atan2(y, z)
     return {"head_1_joint": pan, "head_2_joint": tilt}
 
 
