@@ -47,6 +47,11 @@ class SimThread:
         self.idle_realtime_factor = idle_realtime_factor
         self.sim_time = 0.0  # copy of sim.sim_time, readable from any thread
         self.steps = 0
+        # CPU accounting (load-independent speed): sim seconds advanced while a Motion ran, the
+        # thread's CPU seconds for them, and CPU seconds spent in jobs (IK, rendering, snapshots).
+        self.busy_sim_s = 0.0
+        self.busy_cpu_s = 0.0
+        self.job_cpu_s = 0.0
         self._thread = threading.Thread(target=self._run_maybe_profiled, name="sim", daemon=True)
 
     def start(self, timeout_s: float = 60.0) -> None:
@@ -114,13 +119,18 @@ class SimThread:
         paced_factor: float | None = None
         try:
             while not self._stop.is_set():
+                cpu_before = time.thread_time()
                 self._run_jobs(sim)
+                cpu_after_jobs = time.thread_time()
+                self.job_cpu_s += cpu_after_jobs - cpu_before
                 if sim.busy():
                     for _ in range(_STEPS_BETWEEN_JOB_CHECKS):
                         sim.step()
                         self.steps += 1
                         if not sim.busy():
                             break
+                    self.busy_sim_s += sim.sim_time - self.sim_time
+                    self.busy_cpu_s += time.thread_time() - cpu_after_jobs
                     self.sim_time = sim.sim_time
                     factor = self.realtime_factor_cap
                 else:
@@ -140,6 +150,15 @@ class SimThread:
                 elif ahead_s < -0.5:  # fell behind (busy phases): do not try to catch up later
                     wall_start, sim_start = time.monotonic(), sim.sim_time
         finally:
+            log.info(
+                "sim thread: %.1f s simulated in motion for %.2f s CPU (%.1fx real time per core), "
+                "%.2f s CPU in jobs, %.1f s simulated in all",
+                self.busy_sim_s,
+                self.busy_cpu_s,
+                self.busy_sim_s / self.busy_cpu_s if self.busy_cpu_s > 0 else 0.0,
+                self.job_cpu_s,
+                sim.sim_time,
+            )
             self._drain_after_stop()
             close = getattr(sim, "close", None)
             if callable(close):
