@@ -10,7 +10,7 @@
   (test_failed_get_is_labware_not_picked_and_inventory_stays_true).
 
 The world is the default lab plus a second plate in station_b/2, the occupied destination.
-Tests run in file order and hand the plates on; each ends with plates where the next expects them.
+Tests run in file order (occupied destination, drop, removal) and hand the plate on.
 A fault ends with someone putting the plate back (the fault parameter set to empty), as in a lab.
 """
 
@@ -85,26 +85,6 @@ def assert_lost(cell: Cell, plate: str) -> None:
     """The inventory does not guess: the plate is reported lost, and not aboard."""
     expect_error("UnknownLabware", lambda: cell.location(plate), "is lost")
     assert cell.robot.MobileRobotController.OnboardLabware.get() == []
-
-
-def test_plate_taken_away_during_get_labware_is_labware_not_picked(cell: Cell) -> None:
-    cell.prepare_pick(A1, PLATE)
-    get = cell.manipulator.GetLabware(HandoverPosition=A1, IntermediateActions=[])
-    deadline = time.monotonic() + 30.0
-    while not (get.progress or 0.0) > 0.0:  # the goal runs: the arm heads for the bench pose
-        assert time.monotonic() < deadline and not get.done
-        time.sleep(0.02)
-    set_fault(cell, "fault.remove_plate", PLATE)
-    try:
-        expect_error("LabwareNotPicked", get, "GRASP_FAILED")
-        assert_lost(cell, PLATE)
-        assert not cell.nest_occupied()[A1]
-        assert cell.robot_state() != "Error"
-        # The station's sensor agrees the nest is empty: the scheduler can close the hand-over.
-        finish(cell.site(A1[0]).LabwareRemoved(HandoverPosition=A1))
-    finally:
-        set_fault(cell, "fault.remove_plate", "")  # someone puts the plate back
-    wait_nest(cell, A1, occupied=True)
 
 
 def test_occupied_destination_is_refused_before_any_motion(cell: Cell) -> None:
@@ -183,3 +163,30 @@ def test_plate_dropped_mid_drive_is_labware_not_placed_and_reported_lost(cell: C
     finish(cell.manipulator.PutLabware(HandoverPosition=B1, IntermediateActions=[]))
     finish(cell.site(B1[0]).LabwareDelivered(HandoverPosition=B1))
     assert cell.location(PLATE) == (False, *B1)
+
+
+def test_plate_taken_away_during_get_labware_is_labware_not_picked_and_the_next_pick_works(
+    cell: Cell,
+) -> None:
+    """Runs last: the plate is in station_b/1 after the drop test's recovery."""
+    cell.prepare_pick(B1, PLATE)
+    get = cell.manipulator.GetLabware(HandoverPosition=B1, IntermediateActions=[])
+    deadline = time.monotonic() + 30.0
+    while not (get.progress or 0.0) > 0.0:  # the goal runs: the robot heads for the plate
+        assert time.monotonic() < deadline and not get.done
+        time.sleep(0.02)
+    set_fault(cell, "fault.remove_plate", PLATE)
+    try:
+        expect_error("LabwareNotPicked", get, "GRASP_FAILED")
+        assert_lost(cell, PLATE)
+        assert not cell.nest_occupied()[B1]
+        assert cell.robot_state() != "Error"
+        # The station's sensor agrees the nest is empty: the scheduler can close the hand-over.
+        finish(cell.site(B1[0]).LabwareRemoved(HandoverPosition=B1))
+    finally:
+        set_fault(cell, "fault.remove_plate", "")  # someone puts the plate back (in station_a/1)
+    wait_nest(cell, A1, occupied=True)
+    # The robot is not left unable to work by the failed grasp: the next pick succeeds.
+    cell.prepare_pick(A1, PLATE)
+    cell.pick(A1)
+    assert cell.location(PLATE) == (True, "", 1)
