@@ -29,9 +29,9 @@ def stack(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Deployment]:
     deployment.stop()
 
 
-def run_sila_service_suite(served: ServedServer, ca_file: Path, report_dir: Path) -> tuple[int, str]:
-    """Run the tester's sila_service tests against one server; (exit code, its output)."""
-    completed = subprocess.run(
+def start_sila_service_suite(served: ServedServer, ca_file: Path, report_dir: Path) -> subprocess.Popen[str]:
+    """Start the tester's sila_service tests against one server, in a child process."""
+    return subprocess.Popen(
         [
             sys.executable,
             "-m",
@@ -46,23 +46,28 @@ def run_sila_service_suite(served: ServedServer, ca_file: Path, report_dir: Path
             "--report-file",
             str(report_dir / f"interop-{served.port}.xml"),
         ],
-        capture_output=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
         text=True,
-        timeout=SUITE_TIMEOUT_S,
-        check=False,
     )
-    return completed.returncode, completed.stdout + completed.stderr
 
 
 def test_sila_service_suite_passes_against_every_server(stack: Deployment, tmp_path: Path) -> None:
     assert stack.ca_file is not None, "the deployment runs with TLS and writes its CA"
     roles = {served.role for served in stack.servers}
     assert roles == {"robot", "station"} and len(stack.servers) >= 3
-    for served in stack.servers:
-        exit_code, output = run_sila_service_suite(served, stack.ca_file, tmp_path)
+    # One suite per server, all at once (each is mostly interpreter start-up and schema loading).
+    suites = [(served, start_sila_service_suite(served, stack.ca_file, tmp_path)) for served in stack.servers]
+    for served, suite in suites:
+        try:
+            output, _ = suite.communicate(timeout=SUITE_TIMEOUT_S)
+        finally:
+            if suite.poll() is None:
+                suite.kill()
+                suite.wait()
         summary = output.strip().splitlines()[-1] if output.strip() else ""
         failed_text = f"interop suite failed against {served.name} ({served.port}):\n{output[-4000:]}"
-        assert exit_code == 0, failed_text
+        assert suite.returncode == 0, failed_text
         passed = re.search(r"(\d+) passed", summary)
         assert passed and int(passed.group(1)) >= 20, f"{served.name}: too few tests ran: {summary}"
         assert not re.search(r"\d+ (failed|error|skipped)", summary), f"{served.name}: {summary}"
