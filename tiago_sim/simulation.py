@@ -91,6 +91,8 @@ class Simulation:
         odometry_noise: float = 0.0005,
     ) -> None:
         self.world = world
+        self._nest_sites_of: World | None = None
+        self._nest_sites_cache: list[tuple[str, int, np.ndarray]] = []
         self.time_step = time_step
         self.sim_time = 0.0
         self.rng = np.random.default_rng(seed)
@@ -246,25 +248,49 @@ class Simulation:
     def _site_offset(self, T_world_site: np.ndarray, labware_id: str) -> np.ndarray:
         return tf.invert(T_world_site) @ self._plate_bottom(labware_id)
 
-    def _plate_near(self, T_world_site: np.ndarray) -> str:
-        for labware_id in self.scene.plates:
-            offset = self._site_offset(T_world_site, labware_id)
-            if np.linalg.norm(offset[:2, 3]) < NEST_SENSOR_RANGE and abs(offset[2, 3]) < 0.01:
+    def _plate_bottom_points(self) -> list[tuple[str, np.ndarray]]:
+        """World position of every plate's bottom centre (one query per plate, shared by all sensors)."""
+        points = []
+        for labware_id, body in self.scene.plates.items():
+            position, quat = p.getBasePositionAndOrientation(body, physicsClientId=self.client_id)
+            up = np.array(p.getMatrixFromQuaternion(quat)[2::3])  # the plate's z axis
+            half_height = self.scene.plate_types[labware_id].height / 2
+            points.append((labware_id, np.asarray(position) - half_height * up))
+        return points
+
+    @staticmethod
+    def _plate_near(T_world_site: np.ndarray, bottoms: list[tuple[str, np.ndarray]]) -> str:
+        """The plate whose bottom centre the presence sensor of this site sees, or ""."""
+        for labware_id, point in bottoms:
+            offset = T_world_site[:3, :3].T @ (point - T_world_site[:3, 3])
+            if math.hypot(offset[0], offset[1]) < NEST_SENSOR_RANGE and abs(offset[2]) < 0.01:
                 return labware_id
         return ""
 
+    def _nest_sites(self) -> list[tuple[str, int, np.ndarray]]:
+        """(station, sub-position, T_world_site) of every nest; the stations never move, so cached."""
+        if self._nest_sites_of is not self.world:
+            self._nest_sites_cache = [
+                (station.name, sub, station.T_world_site(sub))
+                for station in self.world.stations
+                for sub in range(1, station.sub_positions + 1)
+            ]
+            self._nest_sites_of = self.world
+        return self._nest_sites_cache
+
     def nest_occupancy(self) -> list[tuple[str, int, bool, str]]:
+        bottoms = self._plate_bottom_points()
         result = []
-        for station in self.world.stations:
-            for sub in range(1, station.sub_positions + 1):
-                labware_id = self._plate_near(station.T_world_site(sub))
-                result.append((station.name, sub, bool(labware_id), labware_id))
+        for name, sub, T_world_site in self._nest_sites():
+            labware_id = self._plate_near(T_world_site, bottoms)
+            result.append((name, sub, bool(labware_id), labware_id))
         return result
 
     def hotel_occupancy(self) -> list[tuple[int, str, str]]:
+        bottoms = self._plate_bottom_points()
         result = []
         for slot in range(1, self.world.hotel_slots + 1):
-            labware_id = self._plate_near(self.robot.link_pose(f"hotel_slot_{slot}"))
+            labware_id = self._plate_near(self.robot.link_pose(f"hotel_slot_{slot}"), bottoms)
             labware_type = self.scene.plate_types[labware_id].name if labware_id else ""
             result.append((slot, labware_id, labware_type))
         return result
