@@ -4,8 +4,9 @@
 - only a client trusting the deployment's CA gets an answer: sila2's SilaClient without root
   certificates, with another CA, or in plain text fails, and so does a raw gRPC channel (plain or
   with the wrong CA) - while the same raw call with the right CA succeeds, so the failures are TLS;
-- the servers bind where --host says: with the default 127.0.0.1 nothing listens on another local
-  address (127.0.0.2 or this machine's network address), and the kernel's socket table agrees.
+- the servers bind where --host says, and nowhere else: by default 127.0.0.1 only; with
+  --host 127.0.0.2 only that (checked in the kernel's socket table and by connecting to the other
+  local addresses: loopback ones and this machine's network address).
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ from sila_stack import free_port_base
 from sila_labware.tls import CertificateAuthority
 
 CLI = [sys.executable, "-m", "sila_labware.cli"]
+CHOSEN_HOST = "127.0.0.2"  # a loopback address other than the default, so the test needs no network
 INSECURE_WARNING = "serving WITHOUT encryption (--insecure)"
 SERVER_NAME_METHOD = "/sila2.org.silastandard.core.silaservice.v1.SiLAService/Get_ServerName"
 
@@ -35,6 +37,7 @@ SERVER_NAME_METHOD = "/sila2.org.silastandard.core.silaservice.v1.SiLAService/Ge
 @dataclass
 class Served:
     process: subprocess.Popen
+    host: str
     port: int
     ca_file: Path
     stdout_lines: list[str]
@@ -59,7 +62,8 @@ def serve(tmp_path: Path, *extra: str) -> Served:
             stop(process)
             pytest.fail(f"serve ended early: {process.stderr.read() if process.stderr else ''}")
         lines.append(line.rstrip("\n"))
-    return Served(process, port, ca_file, lines)
+    host = extra[extra.index("--host") + 1] if "--host" in extra else "127.0.0.1"
+    return Served(process, host, port, ca_file, lines)
 
 
 def stop(process: subprocess.Popen) -> None:
@@ -74,7 +78,7 @@ def stop(process: subprocess.Popen) -> None:
 
 @pytest.fixture(scope="module")
 def tls_serve(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Served]:
-    served = serve(tmp_path_factory.mktemp("security"))  # default host, default TLS
+    served = serve(tmp_path_factory.mktemp("security"), "--host", CHOSEN_HOST)  # default: TLS
     yield served
     stop(served.process)
 
@@ -96,6 +100,7 @@ def test_insecure_serve_warns_at_start(tmp_path: Path) -> None:
         client = SilaClient("127.0.0.1", served.port, insecure=True)
         assert server_name(client) == "TIAGo Labware Robot"
         assert not served.ca_file.exists(), "no CA is written for a plain-text deployment"
+        assert_bound_only_to(served, "127.0.0.1")  # the default --host
     finally:
         stop(served.process)
     assert served.process.returncode == 0
@@ -106,11 +111,13 @@ def test_insecure_serve_warns_at_start(tmp_path: Path) -> None:
 def test_tls_serve_answers_clients_that_trust_its_ca(tls_serve: Served) -> None:
     assert any(line.startswith("CA file for clients:") for line in tls_serve.stdout_lines)
     root_certs = tls_serve.ca_file.read_bytes()
-    client = SilaClient("127.0.0.1", tls_serve.port, root_certs=root_certs)
+    client = SilaClient(tls_serve.host, tls_serve.port, root_certs=root_certs)
     assert server_name(client) == "TIAGo Labware Robot"
-    station = SilaClient("127.0.0.1", tls_serve.port + 1, root_certs=root_certs)
+    station = SilaClient(tls_serve.host, tls_serve.port + 1, root_certs=root_certs)
     assert server_name(station).startswith("Station")
-    channel = grpc.secure_channel(f"127.0.0.1:{tls_serve.port}", grpc.ssl_channel_credentials(root_certs))
+    channel = grpc.secure_channel(
+        f"{tls_serve.host}:{tls_serve.port}", grpc.ssl_channel_credentials(root_certs)
+    )
     with channel:
         assert b"TIAGo Labware Robot" in raw_server_name(channel)
 
@@ -120,13 +127,13 @@ def test_sila_client_without_the_ca_cannot_connect(tls_serve: Served, how: str) 
     started = time.monotonic()
     with pytest.raises(Exception) as caught:  # noqa: PT011 - the library raises what gRPC raises
         if how == "system roots only":
-            client = SilaClient("127.0.0.1", tls_serve.port)
+            client = SilaClient(tls_serve.host, tls_serve.port)
         elif how == "another CA":
             client = SilaClient(
-                "127.0.0.1", tls_serve.port, root_certs=CertificateAuthority().certificate_pem
+                tls_serve.host, tls_serve.port, root_certs=CertificateAuthority().certificate_pem
             )
         else:
-            client = SilaClient("127.0.0.1", tls_serve.port, insecure=True)
+            client = SilaClient(tls_serve.host, tls_serve.port, insecure=True)
         server_name(client)
     assert "TIAGo" not in str(caught.value)
     assert time.monotonic() - started < 30.0, "a refused client must fail, not hang"
@@ -134,7 +141,7 @@ def test_sila_client_without_the_ca_cannot_connect(tls_serve: Served, how: str) 
 
 @pytest.mark.parametrize("how", ["plain text", "another CA"])
 def test_raw_grpc_without_the_ca_cannot_connect(tls_serve: Served, how: str) -> None:
-    target = f"127.0.0.1:{tls_serve.port}"
+    target = f"{tls_serve.host}:{tls_serve.port}"
     if how == "plain text":
         channel = grpc.insecure_channel(target)
     else:
@@ -145,16 +152,15 @@ def test_raw_grpc_without_the_ca_cannot_connect(tls_serve: Served, how: str) -> 
     assert caught.value.code() == grpc.StatusCode.UNAVAILABLE, caught.value
 
 
-def other_local_addresses() -> list[str]:
-    """Addresses of this machine other than 127.0.0.1: another loopback one, and the host's own."""
-    addresses = {"127.0.0.2"}
+def local_addresses() -> list[str]:
+    """Two loopback addresses and this machine's own address on its network, if it has one."""
+    addresses = {"127.0.0.1", CHOSEN_HOST}
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
         try:
             probe.connect(("192.0.2.1", 9))  # no packet is sent: this only picks the outgoing interface
             addresses.add(probe.getsockname()[0])
         except OSError:
             pass
-    addresses.discard("127.0.0.1")
     return sorted(addresses)
 
 
@@ -179,14 +185,17 @@ def listening_addresses(port: int) -> set[str]:
     return found
 
 
-def test_default_bind_is_loopback_only(tls_serve: Served) -> None:
-    for port in range(tls_serve.port, tls_serve.port + 3):  # the robot and both stations
-        assert listening_addresses(port) == {"127.0.0.1"}, "only 127.0.0.1 listens"
-        for address in other_local_addresses():
-            with (
-                pytest.raises(ConnectionRefusedError),
-                socket.create_connection((address, port), timeout=3.0),
-            ):
-                pass
-        with socket.create_connection(("127.0.0.1", port), timeout=3.0):
-            pass
+def assert_bound_only_to(served: Served, host: str) -> None:
+    for port in range(served.port, served.port + 3):  # the robot and both stations
+        assert listening_addresses(port) == {host}, f"only {host} listens on {port}"
+        for address in local_addresses():
+            if address == host:
+                socket.create_connection((address, port), timeout=3.0).close()
+            else:
+                with pytest.raises(ConnectionRefusedError):
+                    socket.create_connection((address, port), timeout=3.0).close()
+
+
+def test_servers_bind_only_where_host_says(tls_serve: Served) -> None:
+    assert tls_serve.host == CHOSEN_HOST
+    assert_bound_only_to(tls_serve, CHOSEN_HOST)
