@@ -29,7 +29,8 @@ log = logging.getLogger(__name__)
 # Straight tool moves (m/s along the line; joint limits cap them too): slow where the plate enters a
 # nest or hotel pocket, where chamfers guide it; faster in free space (approach, lift, carry).
 TOOL_SPEED_INTO_POCKET = 0.08
-TOOL_SPEED_FREE = 0.25
+# 0.15 once "lost the plate" (SLOT_EMPTY): that was the hotel tray hitting the table, see base_alignment
+TOOL_SPEED_FREE = 0.35
 CREEP_HEIGHT = 0.025  # m above a pocket where the slow creep starts (the chamfers are 6 to 10 mm tall)
 
 # Half-turn about the grasp x axis: the same top-down grasp with the fingers swapped.
@@ -165,14 +166,20 @@ class RobotBehaviours:
         """A top-down grasp pose or its twin with the fingers swapped (half-turn about the approach).
 
         With a plate in the gripper, the twin used when it was grasped, so the plate keeps its
-        orientation from nest to hotel and back; otherwise the first reachable in a fixed order.
+        orientation from nest to hotel and back; otherwise the one the arm reaches with less joint
+        travel (e.g. 1.5 instead of 2.7 rad from the tucked arm to the hotel).
         """
         twins = {False: T_base_grasp, True: T_base_grasp @ FLIP_ABOUT_APPROACH}
         order = [self.grasp_flipped.get(arm, False)] if self.holding.get(arm) else [False, True]
+        travel = {}  # twin -> largest joint change to reach it (the slowest joint sets the pace)
         for flip in order:
-            if self.solve_ik(arm, twins[flip], seed) is not None:
-                self.grasp_flipped[arm] = flip
-                return twins[flip]
+            joints = self.solve_ik(arm, twins[flip], seed)
+            if joints is not None:
+                travel[flip] = max(abs(value - seed.get(name, value)) for name, value in joints.items())
+        if travel:
+            flip = min(travel, key=travel.get)
+            self.grasp_flipped[arm] = flip
+            return twins[flip]
         raise ActionAbort(
             ErrorCodes.IK_FAILED, f"the {arm} arm cannot reach {np.round(T_base_grasp[:3, 3], 3)}"
         )
@@ -192,10 +199,14 @@ class RobotBehaviours:
         free: bool = False,
         tool_speed: float = TOOL_SPEED_FREE,
     ) -> None:
-        """Straight tool move to a top-down grasp pose; with `free`, a joint-space move when no
-        straight line exists (e.g. from the folded Home pose, where nothing is in the way)."""
+        """Straight tool move to a top-down grasp pose; with `free`, a joint-space move when the
+        gripper is empty or no straight line exists (e.g. from the folded arm, where nothing is in
+        the way)."""
         seed = run.sim(lambda sim: dict(sim.joint_positions()))
         target = self.grasp_twin(arm, T_base_grasp, seed)
+        if free and not self.holding.get(arm):  # an empty gripper from the tucked arm: the short way
+            self.joint_space_move(run, arm, target, span)
+            return
         try:
             self.straight_move(run, arm, target, tool_speed, span)
         except ActionAbort as abort:

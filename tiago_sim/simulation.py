@@ -343,7 +343,7 @@ class Simulation:
             (self.world.pois[self.world.dock_poi].x, self.world.pois[self.world.dock_poi].y),
         )
         goal = (x + distance * math.cos(yaw), y + distance * math.sin(yaw), yaw)
-        motion = DriveMotion(self.base, *goal, speed=0.2, name="undock")
+        motion = DriveMotion(self.base, *goal, speed=0.3, name="undock")  # contacts open at once: no creep
         motion.phase = "driving"
         return self._start(motion)
 
