@@ -77,6 +77,7 @@ class RobotBody:
         )
         p.changeConstraint(self.base_constraint, maxForce=BASE_CONSTRAINT_FORCE, physicsClientId=client)
         self.targets: dict[str, float] = {}
+        self._track_groups: dict[tuple[str, ...], tuple] = {}
         self.frame_offsets = _fixed_frame_offsets()
 
     def set_base_target(self, x: float, y: float, yaw: float) -> None:
@@ -146,11 +147,26 @@ class RobotBody:
 
     def track(self, names: list[str], positions: np.ndarray, velocities: np.ndarray) -> None:
         """Per-step trajectory tracking in one call (targets already timed within the velocity limits)."""
-        indices = [self.joint_index[n] for n in names]
-        clipped = []
-        for name, value in zip(names, positions.tolist(), strict=True):
-            lower, upper = self.limits[name][0], self.limits[name][1]
-            clipped.append(min(max(value, lower), upper) if upper > lower else value)
+        key = tuple(names)
+        group = self._track_groups.get(key)
+        if group is None:  # per joint group, built once: this runs at every physics step of a motion
+            lower = np.array(
+                [self.limits[n][0] if self.limits[n][1] > self.limits[n][0] else -np.inf for n in names]
+            )
+            upper = np.array(
+                [self.limits[n][1] if self.limits[n][1] > self.limits[n][0] else np.inf for n in names]
+            )
+            group = (
+                [self.joint_index[n] for n in names],
+                lower,
+                upper,
+                [self.limits[n][3] for n in names],
+                [ARM_POSITION_GAIN] * len(names),
+                [1.0] * len(names),
+            )
+            self._track_groups[key] = group
+        indices, lower, upper, forces, position_gains, velocity_gains = group
+        clipped = np.minimum(np.maximum(positions, lower), upper).tolist()
         self.targets.update(zip(names, clipped, strict=True))
         p.setJointMotorControlArray(
             self.id,
@@ -158,9 +174,9 @@ class RobotBody:
             p.POSITION_CONTROL,
             targetPositions=clipped,
             targetVelocities=np.asarray(velocities, dtype=float).tolist(),
-            forces=[self.limits[n][3] for n in names],
-            positionGains=[ARM_POSITION_GAIN] * len(names),
-            velocityGains=[1.0] * len(names),
+            forces=forces,
+            positionGains=position_gains,
+            velocityGains=velocity_gains,
             physicsClientId=self.client,
         )
 

@@ -152,12 +152,13 @@ class SimThread:
         finally:
             log.info(
                 "sim thread: %.1f s simulated in motion for %.2f s CPU (%.1fx real time per core), "
-                "%.2f s CPU in jobs, %.1f s simulated in all",
+                "%.2f s CPU in jobs, %.1f s simulated in all; the whole process used %.2f s CPU",
                 self.busy_sim_s,
                 self.busy_cpu_s,
                 self.busy_sim_s / self.busy_cpu_s if self.busy_cpu_s > 0 else 0.0,
                 self.job_cpu_s,
                 sim.sim_time,
+                time.process_time(),
             )
             self._drain_after_stop()
             close = getattr(sim, "close", None)
