@@ -42,7 +42,7 @@ from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.task import Future
 
 from tiago_sim.node_main import spin_node
-from tiago_sim.task_plans import Step, TaskRefused, Workcell, get_plan, put_plan
+from tiago_sim.task_plans import Step, TaskRefused, Workcell, get_plan, put_plan, retreat_after_empty_grasp
 
 log = logging.getLogger("tiago_sim.sequencer")
 
@@ -229,6 +229,8 @@ class Sequencer:
                 run.publish()  # the last word is progress 1.0
                 return self._finish(goal_handle, result, "", "done")
             except StepFailed as failure:
+                if failure.code == ErrorCodes.GRASP_FAILED:
+                    await self._retreat(run, plan)
                 return self._finish(goal_handle, result, failure.code, failure.message)
             except Exception as error:  # noqa: BLE001 - every goal ends with a result
                 log.exception("task failed")
@@ -237,6 +239,17 @@ class Sequencer:
                 self.active = None
 
         return execute
+
+    async def _retreat(self, run: TaskRun, plan: list[Step]) -> None:
+        """Best effort after an empty grasp: bring the arm out of the nest or pocket and tuck it;
+        the task still ends with GRASP_FAILED, whatever happens here."""
+        for step in retreat_after_empty_grasp(plan, run.index):
+            try:
+                run.phase = step.phase
+                await self._run_step(run, step)
+            except StepFailed as failure:
+                log.warning("retreat after an empty grasp stopped: %s", failure.message)
+                return
 
     def _labware_id(self, request: Any, from_hotel: bool) -> str:
         """The plate's id as the robot's sensors report it at the source, else the one asked for."""

@@ -151,3 +151,22 @@ def put_plan(goal: Any, workcell: Workcell, robot_state: Any, station_states: An
         Step("marker_motion", {**site, "target": "site_approach"}, "retract"),
         Step("play_motion", {"motion_name": "Tuck", "arm": arm}, "arm tucked"),
     ]
+
+
+def retreat_after_empty_grasp(plan: list[Step], grasp_index: int) -> list[Step]:
+    """After a grasp that closed on nothing: open, back out along the plan's own lift step, tuck.
+
+    Why: the arm reached its target, so the way it came in is clear; left there it stands in the
+    nest, in front of the marker the next task must see first (seen: MARKER_NOT_FOUND after a plate
+    was taken away mid-GetLabware). Empty when the plan has no lift step after the grasp.
+    """
+    grasp = plan[grasp_index]
+    arm = grasp.goal.get("arm", "")
+    lift = plan[grasp_index + 1] if grasp_index + 1 < len(plan) else None
+    if lift is None or lift.action not in ("marker_motion", "play_motion"):
+        return []
+    return [
+        Step("gripper", {"command": "open", "arm": arm}, "releasing after an empty grasp"),
+        Step(lift.action, dict(lift.goal), "backing out"),
+        Step("play_motion", {"motion_name": "Tuck", "arm": arm}, "arm tucked"),
+    ]
