@@ -143,6 +143,33 @@ def _add_base(w: UrdfWriter) -> None:
         w.joint(f"caster_{i + 1}_joint", "fixed", "base_link", f"caster_{i + 1}_link", (cx, cy, -0.0735))
 
 
+@dataclass(frozen=True)
+class HeadJoint:
+    """Pan (head_1) and tilt (head_2), with the link each one moves (no collision shape)."""
+
+    name: str
+    parent: str
+    xyz: tuple[float, float, float]
+    rpy: tuple[float, float, float]
+    limits_deg: tuple[float, float]
+    effort: float  # N m
+    mass: float  # kg of the link
+    shape: tuple  # (shape, size, xyz, rpy, material) as UrdfWriter.link takes it
+
+
+HEAD_SPEED = 3.0  # rad/s, both joints
+HEAD_JOINTS = (
+    HeadJoint(
+        "head_1", "torso_lift_link", (0.182, 0, 0), (0, 0, 0), (-75.0, 75.0), 5.2, 0.5,
+        ("cylinder", (0.04, 0.09), (0, 0, 0.045), (0, 0, 0), "dark"),
+    ),
+    HeadJoint(
+        "head_2", "head_1_link", (0.005, 0, 0.098), (math.pi / 2, 0, 0), (-60.0, 45.0), 2.8, 0.8,
+        ("box", (0.14, 0.12, 0.2), (0.03, 0.06, 0), (0, 0, 0), "white"),
+    ),
+)  # fmt: skip
+
+
 def _add_torso_and_head(w: UrdfWriter) -> None:
     w.link("torso_fixed_link", 8.0, [("box", (0.24, 0.3, 0.5), (0, 0, 0.23), (0, 0, 0), "grey")])
     w.joint("torso_fixed_joint", "fixed", "base_link", "torso_fixed_link", (-0.062, 0, 0.193))
@@ -165,31 +192,20 @@ def _add_torso_and_head(w: UrdfWriter) -> None:
         effort=2000.0,
         velocity=TORSO_LIFT_SPEED,
     )
-    w.link("head_1_link", 0.5, [("cylinder", (0.04, 0.09), (0, 0, 0.045), (0, 0, 0), "dark")], collide=False)
-    w.joint(
-        "head_1_joint",
-        "revolute",
-        "torso_lift_link",
-        "head_1_link",
-        (0.182, 0, 0),
-        limits=(-75 * DEG, 75 * DEG),
-        effort=5.2,
-        velocity=3.0,
-    )
-    w.link(
-        "head_2_link", 0.8, [("box", (0.14, 0.12, 0.2), (0.03, 0.06, 0), (0, 0, 0), "white")], collide=False
-    )
-    w.joint(
-        "head_2_joint",
-        "revolute",
-        "head_1_link",
-        "head_2_link",
-        (0.005, 0, 0.098),
-        (math.pi / 2, 0, 0),
-        limits=(-60 * DEG, 45 * DEG),
-        effort=2.8,
-        velocity=3.0,
-    )
+    for joint in HEAD_JOINTS:
+        link = f"{joint.name}_link"
+        w.link(link, joint.mass, [joint.shape], collide=False)
+        w.joint(
+            f"{joint.name}_joint",
+            "revolute",
+            joint.parent,
+            link,
+            joint.xyz,
+            joint.rpy,
+            limits=(joint.limits_deg[0] * DEG, joint.limits_deg[1] * DEG),
+            effort=joint.effort,
+            velocity=HEAD_SPEED,
+        )
     # camera_link (x forward, z up when the head is at zero) and its OpenCV optical frame
     w.link(
         "head_camera_link", 0.05, [("box", (0.02, 0.1, 0.03), (0, 0, 0), (0, 0, 0), "dark")], collide=False
