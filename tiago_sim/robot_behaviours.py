@@ -240,6 +240,7 @@ class RobotBehaviours:
         except ActionAbort as abort:
             if abort.code != ErrorCodes.IK_FAILED:
                 raise
+            log.info("the arm alone cannot follow the line (%s): planning with the torso", abort.message)
             run.run_motion(lambda sim: sim.move_tool(arm, T_base_grasp, True, tool_speed, True), span=span)
 
     def joint_space_move(
