@@ -23,6 +23,8 @@ log = logging.getLogger(__name__)
 IK_DAMPING = 1e-3
 IK_POSITION_TOLERANCE = 5e-4  # m
 IK_ORIENTATION_TOLERANCE = 2e-3  # rad
+IK_STALL_ITERATIONS = 15  # a solve ends when its error has not dropped by IK_STALL_PROGRESS in this many
+IK_STALL_PROGRESS = 1e-6  # m (+ 0.1 m per rad)
 
 
 @dataclass(frozen=True)
@@ -129,7 +131,8 @@ class RobotKinematics:
     ) -> tuple[np.ndarray, float, float]:
         eye = np.eye(6)
         pos_err = rot_err = float("inf")
-        for _ in range(max_iterations):
+        best_err, best_at = float("inf"), 0
+        for iteration in range(max_iterations):
             pin.forwardKinematics(self.model, self.data, q)
             pin.updateFramePlacement(self.model, self.data, frame_id)
             current = self.data.oMf[frame_id]
@@ -137,6 +140,12 @@ class RobotKinematics:
             pos_err = float(np.linalg.norm(target.translation - current.translation))
             rot_err = float(np.linalg.norm(error[3:]))
             if pos_err <= IK_POSITION_TOLERANCE * 0.2 and rot_err <= IK_ORIENTATION_TOLERANCE * 0.2:
+                break
+            # Stalled (pinned at joint limits, or a local minimum): further iterations change nothing,
+            # so give the time to the next restart instead.
+            if pos_err + 0.1 * rot_err < best_err - IK_STALL_PROGRESS:
+                best_err, best_at = pos_err + 0.1 * rot_err, iteration
+            elif iteration - best_at >= IK_STALL_ITERATIONS:
                 break
             jacobian = pin.computeFrameJacobian(self.model, self.data, q, frame_id, pin.LOCAL)[:, indices]
             step = jacobian.T @ np.linalg.solve(jacobian @ jacobian.T + IK_DAMPING * eye, error)
