@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Iterator
+from typing import Any
 
 import pytest
 from sila2.framework import DefinedExecutionError
@@ -50,20 +51,32 @@ def reported_location(cell: Cell) -> str:
     return f"hotel:{slots[0]}" if slots else "gripper"
 
 
-def test_stop_motion_cancels_get_labware_and_everything_stays_consistent(cell: Cell) -> None:
-    cell.prepare_pick(A1, PLATE)
-    get = cell.manipulator.GetLabware(HandoverPosition=A1, IntermediateActions=[])
+def cancel_mid_way(cell: Cell, get: Any) -> float:
+    """Wait until GetLabware is under way, then StopMotion; returns when StopMotion was called."""
     deadline = time.monotonic() + 60.0
     while (get.progress or 0.0) < CANCEL_AT_PROGRESS:
         assert not get.done, "GetLabware ended before it could be cancelled"
         assert time.monotonic() < deadline, f"GetLabware made no progress: {get.progress}"
         time.sleep(0.02)
-    assert cell.robot_state() == "Manipulating"
-
+    assert not get.done
     cell.robot.MobileRobotController.StopMotion()
-    stopped_at = time.monotonic()
-    with pytest.raises(DefinedExecutionError, match="CANCELED") as raised:
-        finish(get, timeout_s=30.0)
+    return time.monotonic()
+
+
+def test_stop_motion_cancels_get_labware_and_everything_stays_consistent(cell: Cell) -> None:
+    cell.prepare_pick(A1, PLATE)
+    get = cell.manipulator.GetLabware(HandoverPosition=A1, IntermediateActions=[])
+    try:
+        stopped_at = cancel_mid_way(cell, get)
+        with pytest.raises(DefinedExecutionError, match="CANCELED") as raised:
+            finish(get, timeout_s=30.0)
+    finally:
+        # Never leave the command running (its client stream would outlive the test).
+        if not get.done:
+            cell.robot.MobileRobotController.StopMotion()
+            give_up_at = time.monotonic() + 30.0
+            while not get.done and time.monotonic() < give_up_at:
+                time.sleep(0.05)
     assert raised.value.identifier == "LabwareNotPicked", raised.value
     assert time.monotonic() - stopped_at < 10.0
 
