@@ -80,7 +80,11 @@ def test_stop_motion_cancels_get_labware_and_everything_stays_consistent(cell: C
     assert raised.value.identifier == "LabwareNotPicked", raised.value
     assert time.monotonic() - stopped_at < 10.0
 
-    # The robot is at rest and not in error; a second StopMotion finds nothing to stop.
+    # The robot comes to rest, not in error (its state topic may lag the result by a few
+    # messages); a second StopMotion then finds nothing to stop.
+    at_rest_by = time.monotonic() + 3.0
+    while cell.robot_state() != "Idle" and time.monotonic() < at_rest_by:
+        time.sleep(0.05)
     assert cell.robot_state() == "Idle"
     cell.robot.MobileRobotController.StopMotion()
 
