@@ -96,7 +96,7 @@ def align_base(
     head_at_work = {name: value for name, value in working_joints.items() if name in HEAD_JOINTS}
     turning = run.sim(lambda sim: sim.move_joints(head_at_work)) if head_at_work else None
     run.run_motion(lambda sim: sim.drive_to(*goal, speed=ALIGN_SPEED), span=(0.2, 0.9))
-    for motion in (lifting, turning):
+    for motion, span in ((lifting, (0.9, 0.95)), (turning, (0.95, 1.0))):
         if motion is not None:
-            run.run_motion(lambda _sim, motion=motion: motion, span=(0.9, 1.0))
+            run.run_motion(lambda _sim, motion=motion: motion, span=span)
     return look(run)  # from the working pose: later tool moves reuse it while the base stands

@@ -85,7 +85,7 @@ class MarkerMotionBehaviour:
             rgb, depth, intrinsics = sim.render_head_camera()
             return rgb, depth, intrinsics, dict(sim.joint_positions()), tuple(sim.odometry())
 
-        run.feedback(0.05, "looking", 0.0, force=True)
+        run.feedback(max(run.progress, 0.05), "looking", 0.0, force=True)  # progress never goes back
         rgb, depth, intrinsics, joints, odometry = run.sim(capture)
         observation = detect_marker(rgb, intrinsics, station.marker_id, station.marker_size, depth)
         if observation is None:

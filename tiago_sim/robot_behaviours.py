@@ -87,9 +87,9 @@ class RobotBehaviours:
         if run.sim(lambda sim: sim.is_docked()):
             raise ActionAbort(ErrorCodes.DOCKED, "the robot is docked: undock first")
         lowering = self._lower_torso(run)
-        run.run_motion(lambda sim: sim.drive_to(*pose))
+        run.run_motion(lambda sim: sim.drive_to(*pose), span=(0.0, 0.95))
         if lowering is not None:
-            run.run_motion(lambda _sim: lowering)
+            run.run_motion(lambda _sim: lowering, span=(0.95, 1.0))
         return {}
 
     def _lower_torso(self, run: ActionRun) -> Any:
