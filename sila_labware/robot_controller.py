@@ -315,6 +315,13 @@ class RobotController:
             status = self.link.wait_for_robot_status(shows_outcome, timeout_s=3.0)
         except BridgeTimeout:
             status = self.link.robot_status()
+        if outcome.success and not expect_aboard:
+            # /station_states comes at 2 Hz, /robot_state on change: without this wait a plate that
+            # was placed could be read as in neither place, and recorded as lost (seen in the soak).
+            try:
+                self.link.wait_for_nest(transfer.handover.station, transfer.handover.sub_position, True, 3.0)
+            except BridgeTimeout:
+                logger.warning("PutLabware succeeded but the sensor of %s sees no plate", transfer.handover)
         location = self.inventory.settle(
             labware_id, transfer.labware_type, transfer.handover, status, self.link.nest_occupancies()
         )
