@@ -20,6 +20,7 @@ from typing import Any
 import pytest
 from sila2.framework import DefinedExecutionError
 from sila_stack import start_stack
+from sim_parameters import set_node_parameter
 from transfer_steps import Cell, finish
 
 PLATE = "plate_001"
@@ -65,12 +66,16 @@ def cancel_mid_way(cell: Cell, get: Any) -> float:
 
 def test_stop_motion_cancels_get_labware_and_everything_stays_consistent(cell: Cell) -> None:
     cell.prepare_pick(A1, PLATE)
+    # Paced at real time, the reach for the plate takes seconds of wall time, so the cancel lands
+    # before the grasp however fast the machine or the motions are.
+    set_node_parameter(cell.deployment.runtime, "realtime_factor_cap", 1.0)
     get = cell.manipulator.GetLabware(HandoverPosition=A1, IntermediateActions=[])
     try:
         stopped_at = cancel_mid_way(cell, get)
         with pytest.raises(DefinedExecutionError, match="CANCELED") as raised:
             finish(get, timeout_s=30.0)
     finally:
+        set_node_parameter(cell.deployment.runtime, "realtime_factor_cap", 0.0)
         # Never leave the command running (its client stream would outlive the test).
         if not get.done:
             cell.robot.MobileRobotController.StopMotion()
