@@ -37,7 +37,8 @@ A, B = ("station_a", 1), ("station_b", 1)
 BRIDGE_NODE = "sila_labware_bridge"
 
 # Bounds, measured from the baseline taken after the first round trip (A->B->A), when every pool,
-# cache and lazily created gRPC/DDS thread has been used once:
+# cache and lazily created gRPC/DDS thread has been used once (the sample after the first transfer
+# is reported too, but the way back still warms up the other station's paths):
 # - threads: sila2 keeps one thread per observable command execution for the command's lifetime of
 #   execution (30 min, set by the feature implementations) so that clients can still fetch its
 #   result; a transfer runs 8 observable commands (4 on the robot, 2 on each station), all in the
@@ -187,22 +188,31 @@ def test_many_transfers_in_one_serve_process_leak_nothing(tmp_path: Path) -> Non
         durations: list[float] = []
         samples: dict[int, dict[str, ProcessSample]] = {}
         graph: dict[int, dict[str, int]] = {}
+        failure = ""
         for number in range(1, TRANSFERS + 1):
             source, destination = (A, B) if number % 2 else (B, A)
             began = time.monotonic()
-            cell.transfer(source, destination, PLATE)
+            try:
+                cell.transfer(source, destination, PLATE)
+            except Exception as error:  # noqa: BLE001 - reported with the figures gathered so far
+                failure = f"transfer {number} ({source[0]} -> {destination[0]}) failed: {error}"
+                samples[number] = {name: sample(pid) for name, pid in watched.items()}
+                graph[number] = ros_graph_of_bridge(runtime)
+                break
             durations.append(time.monotonic() - began)
             assert cell.location(PLATE) == (False, destination[0], destination[1])
-            if number == 2 or number % 5 == 0 or number == TRANSFERS:
+            if number <= 2 or number % 5 == 0 or number == TRANSFERS:
                 samples[number] = {name: sample(pid) for name, pid in watched.items()}
                 graph[number] = ros_graph_of_bridge(runtime)
             print(f"transfer {number}: {source[0]} -> {destination[0]} in {durations[-1]:.1f} s", flush=True)
         wall_s = time.monotonic() - started
 
         goals_left = unfinished_goals(runtime)
-        baseline, end = samples[2], samples[TRANSFERS]
+        last = max(samples)
+        baseline, end = samples[2], samples[last]
         report = {
-            "transfers": TRANSFERS,
+            "transfers": len(durations),
+            "failure": failure,
             "wall_s": round(wall_s, 1),
             "transfer_s": {
                 "median": round(sorted(durations)[len(durations) // 2], 1),
@@ -216,18 +226,19 @@ def test_many_transfers_in_one_serve_process_leak_nothing(tmp_path: Path) -> Non
         print(json.dumps(report, indent=1), flush=True)
         if os.environ.get("SOAK_REPORT"):
             Path(os.environ["SOAK_REPORT"]).write_text(json.dumps(report, indent=1) + "\n")
+        assert not failure, failure
 
         assert serve.poll() is None and all(Path(f"/proc/{pid}").exists() for pid in children.values()), (
             "the robot side must not have been restarted during the soak"
         )
         for name in watched:
             thread_growth = end[name].threads - baseline[name].threads
-            parked_threads = OBSERVABLE_COMMANDS_PER_TRANSFER * (TRANSFERS - 2) if name == "serve" else 0
+            parked_threads = OBSERVABLE_COMMANDS_PER_TRANSFER * (last - 2) if name == "serve" else 0
             assert thread_growth <= parked_threads + THREAD_NOISE, (name, baseline[name], end[name])
             memory_growth = end[name].rss_kib - baseline[name].rss_kib
             memory_limit = MEMORY_GROWTH_LIMIT_KIB + MEMORY_PER_PARKED_THREAD_KIB * max(0, thread_growth)
             assert memory_growth <= memory_limit, f"{name} grew {memory_growth} KiB over the soak"
-        assert graph[TRANSFERS] == graph[2], "the bridge's ROS endpoints changed: subscriptions leak"
+        assert graph[last] == graph[2], "the bridge's ROS endpoints changed: subscriptions leak"
         assert goals_left and not any(goals_left.values()), f"goals still open: {goals_left}"
         assert cell.robot_state() == "Idle"
     finally:
