@@ -21,9 +21,10 @@ import math
 from typing import Any
 
 import numpy as np
+from labware_interfaces.msg import ErrorCodes
 
 from tiago_sim import transforms as tf
-from tiago_sim.action_run import ActionRun
+from tiago_sim.action_run import ActionAbort, ActionRun
 from tiago_sim.kinematics import RobotKinematics
 from tiago_sim.world import Station
 
@@ -31,6 +32,7 @@ log = logging.getLogger(__name__)
 
 HEAD_JOINTS = ("head_1_joint", "head_2_joint")
 CAMERA_FRAME = "head_camera_optical_frame"
+SEARCH_PAN_OFFSETS = (0.0, 0.45, -0.45, 0.9, -0.9)  # rad; the camera sees 63 deg across
 ALIGN_SPEED = 0.3  # m/s cap for the short final drive (the acceleration limit keeps it lower anyway)
 
 
@@ -63,6 +65,27 @@ def compose_planar(
     return a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], tf.wrap_angle(a[2] + b[2])
 
 
+def _search(run: ActionRun, head: dict[str, float], look: Any) -> Any:
+    """Point the head where the marker should be and look; if it is not in the image, pan left and
+    right and look again (odometry drifts over a long drive: seed 316 arrived 18 cm and 5 deg off
+    its belief). Every extra look is logged; MARKER_NOT_FOUND only when all of them fail."""
+    failure: ActionAbort | None = None
+    for index, pan_offset in enumerate(SEARCH_PAN_OFFSETS):
+        aim = {**head, "head_1_joint": head["head_1_joint"] + pan_offset}
+        if index:
+            log.info("marker not in view: looking %.0f deg further %s", abs(math.degrees(pan_offset)),
+                     "left" if pan_offset > 0 else "right")  # fmt: skip
+        run.run_motion(lambda sim, aim=aim: sim.move_joints(aim), span=(0.0, 0.15))
+        try:
+            return look(run)
+        except ActionAbort as abort:
+            if abort.code != ErrorCodes.MARKER_NOT_FOUND:
+                raise
+            failure = abort
+    assert failure is not None
+    raise failure
+
+
 def align_base(
     run: ActionRun,
     station: Station,
@@ -83,8 +106,7 @@ def align_base(
     # readings of the same instant, so the camera pose stays exact while it moves.
     torso = {name: value for name, value in working_joints.items() if name not in HEAD_JOINTS}
     lifting = run.sim(lambda sim: sim.move_joints(torso)) if torso else None
-    run.run_motion(lambda sim: sim.move_joints(head), span=(0.0, 0.15))
-    sighting = look(run)
+    sighting = _search(run, head, look)
     T_marker_work = tf.invert(station.T_world_marker()) @ station.aligned_pose().matrix()
     correction = planar(sighting.T_base_marker @ T_marker_work)  # working pose in base_footprint
     odometry = run.sim(lambda sim: tuple(sim.odometry()))
