@@ -78,3 +78,28 @@ def test_planar_poses_compose_like_transforms():
     a, b = (1.0, 2.0, 0.5), (0.3, -0.1, 0.2)
     expected = planar(tf.from_planar(*a) @ tf.from_planar(*b))
     np.testing.assert_allclose(compose_planar(a, b), expected, atol=1e-12)
+
+
+@pytest.mark.parametrize("offset", [(0.006, 0.0), (0.0, 0.006), (0.005, 0.005)])
+def test_a_plate_released_off_centre_slides_into_the_hotel_pocket(offset):
+    """A plate carried a few mm off centre in the gripper must not stay on a hotel lead-in."""
+    world = load_world()
+    world = dataclasses.replace(world, plates=(InitialPlate(PLATE, "sbs_microplate_96", hotel_slot=1),))
+    sim = Simulation(world, seed=4)
+    try:
+        T_world_slot = sim.robot.link_pose("hotel_slot_1")
+        release = T_world_slot @ tf.make_transform((*offset, 0.012 + 0.01435 / 2))  # 12 mm above the floor
+        position, quat = tf.to_pose(release)
+        body = sim.scene.plates[PLATE]
+        p.resetBasePositionAndOrientation(
+            body, position.tolist(), quat.tolist(), physicsClientId=sim.client_id
+        )
+        for _ in range(480):
+            sim.step()
+        seated = tf.invert(T_world_slot) @ tf.from_pose(
+            *p.getBasePositionAndOrientation(body, physicsClientId=sim.client_id)
+        )
+        assert abs(seated[2, 3] - 0.01435 / 2) < 0.001, f"resting {1000 * seated[2, 3]:.1f} mm up"
+        assert sim.hotel_occupancy()[0][:2] == (1, PLATE)
+    finally:
+        sim.close()
