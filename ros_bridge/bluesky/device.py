@@ -32,7 +32,7 @@ from ophyd.status import DeviceStatus
 
 from ros_bridge.bluesky.status import ActionStatus
 from ros_bridge.errors import BridgeError
-from ros_bridge.robot_link import RobotLink
+from ros_bridge.robot_link import LabwareHandover, RobotLink
 from ros_bridge.workcell import RobotStatus
 
 logger = logging.getLogger(__name__)
@@ -133,7 +133,8 @@ class LabwareTransferRobot(Device):
         label = f"{task.value} {labware_id} {'from' if _is_get(task) else 'to'} {site}"
         send = self.link.get_labware if _is_get(task) else self.link.put_labware
         logger.info("%s: %s (hotel slot %d)", self.name, label, hotel_slot)
-        goal = send(site.station, site.sub_position, hotel_slot, self.labware_type, labware_id)
+        handover = LabwareHandover(site.station, site.sub_position, hotel_slot, self.labware_type, labware_id)
+        goal = send(handover)
         status = ActionStatus(self, goal, label=label, timeout=self.task_timeout_s)
         self.last_task.report(task.value)
         with self._running_lock:
