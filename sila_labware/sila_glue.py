@@ -18,6 +18,11 @@ from sila2.server import ObservableCommandInstance
 from sila_labware.errors import ParameterError
 from sila_labware.robot_controller import ProgressReport
 
+COMMAND_LIFETIME = timedelta(minutes=10)
+"""How long a finished observable command's result stays available to clients, counted from its
+start. sila2 keeps one waiting thread per command for this long, so it bounds the threads of a
+busy server (a transfer runs 8 commands: at one transfer per 12 s, about 400 threads)."""
+
 logger = logging.getLogger(__name__)
 
 

@@ -40,11 +40,11 @@ BRIDGE_NODE = "sila_labware_bridge"
 # cache and lazily created gRPC/DDS thread has been used once (the sample after the first transfer
 # is reported too, but the way back still warms up the other station's paths):
 # - threads: sila2 keeps one thread per observable command execution for the command's lifetime of
-#   execution (30 min, set by the feature implementations) so that clients can still fetch its
+#   execution (sila_glue.COMMAND_LIFETIME, 10 min from its start) so that clients can still fetch its
 #   result; a transfer runs 8 observable commands (4 on the robot, 2 on each station), all in the
-#   serve process. So the serve process may gain at most 8 threads per transfer (they end 30 min
-#   later), plus 2 for noise; the robot-side children must stay within 2 threads. A thread leaked
-#   per goal, subscription or gRPC stream would exceed this.
+#   serve process. So the serve process may gain at most 8 threads per transfer (they end 10 min
+#   after their command started), plus 2 for noise; the robot-side children must stay within 2
+#   threads. A thread leaked per goal, subscription or gRPC stream would exceed this.
 # - memory: 25 MiB per process, plus 64 KiB for each of those parked threads in the serve process
 #   (about 35 KiB each was measured: touched stack pages and interpreter state). Allocator noise
 #   between samples was a few MiB; a leak of what a transfer handles (one 640x480 RGBA frame =

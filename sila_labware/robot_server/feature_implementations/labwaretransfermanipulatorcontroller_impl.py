@@ -9,14 +9,13 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
-from datetime import timedelta
 from typing import TYPE_CHECKING, TypeVar
 
 from sila2.server import MetadataDict, ObservableCommandInstance
 
 from sila_labware.errors import CommandSequenceError, ParameterError
 from sila_labware.robot_controller import INTERMEDIATE_ACTIONS, MotionFailed, TransferFailed
-from sila_labware.sila_glue import handover_position, progress_reporter, validation_error
+from sila_labware.sila_glue import COMMAND_LIFETIME, handover_position, progress_reporter, validation_error
 
 from ..generated.labwaretransfermanipulatorcontroller import (
     GetLabware_Responses,
@@ -44,10 +43,10 @@ class LabwareTransferManipulatorControllerImpl(LabwareTransferManipulatorControl
     def __init__(self, parent_server: Server) -> None:
         super().__init__(parent_server=parent_server)
         self.robot = parent_server.robot
-        self.PrepareForInput_default_lifetime_of_execution = timedelta(minutes=30)
-        self.PrepareForOutput_default_lifetime_of_execution = timedelta(minutes=30)
-        self.PutLabware_default_lifetime_of_execution = timedelta(minutes=30)
-        self.GetLabware_default_lifetime_of_execution = timedelta(minutes=30)
+        self.PrepareForInput_default_lifetime_of_execution = COMMAND_LIFETIME
+        self.PrepareForOutput_default_lifetime_of_execution = COMMAND_LIFETIME
+        self.PutLabware_default_lifetime_of_execution = COMMAND_LIFETIME
+        self.GetLabware_default_lifetime_of_execution = COMMAND_LIFETIME
 
     def get_AvailableHandoverPositions(self, *, metadata: MetadataDict) -> list[HandoverPosition]:
         return [handover_position(name, count) for name, count in self.robot.handover_positions()]

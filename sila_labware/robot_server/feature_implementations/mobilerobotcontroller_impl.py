@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
-from datetime import timedelta
 from typing import TYPE_CHECKING
 
 from sila2.server import MetadataDict, ObservableCommandInstance
@@ -17,7 +16,7 @@ from sila2.server import MetadataDict, ObservableCommandInstance
 from ros_bridge.workcell import RobotStatus
 from sila_labware.errors import CommandSequenceError, ParameterError
 from sila_labware.robot_controller import MotionFailed
-from sila_labware.sila_glue import progress_reporter, validation_error
+from sila_labware.sila_glue import COMMAND_LIFETIME, progress_reporter, validation_error
 
 from ..generated.mobilerobotcontroller import (
     Dock_Responses,
@@ -63,9 +62,9 @@ class MobileRobotControllerImpl(MobileRobotControllerBase):
     def __init__(self, parent_server: Server) -> None:
         super().__init__(parent_server=parent_server)
         self.robot = parent_server.robot
-        self.Dock_default_lifetime_of_execution = timedelta(minutes=30)
-        self.Undock_default_lifetime_of_execution = timedelta(minutes=30)
-        self.DriveToPointOfInterest_default_lifetime_of_execution = timedelta(minutes=30)
+        self.Dock_default_lifetime_of_execution = COMMAND_LIFETIME
+        self.Undock_default_lifetime_of_execution = COMMAND_LIFETIME
+        self.DriveToPointOfInterest_default_lifetime_of_execution = COMMAND_LIFETIME
         # Subscribers wait forever without a first value: publish the current state now.
         self._publish_status(self.robot.link.robot_status())
         self.robot.link.on_robot_status(self._publish_status)

@@ -10,13 +10,12 @@ sensor confirms the plate arrived/left.
 from __future__ import annotations
 
 from collections.abc import Callable
-from datetime import timedelta
 from typing import TYPE_CHECKING
 
 from sila2.server import MetadataDict, ObservableCommandInstance
 
 from sila_labware.errors import CommandSequenceError, ParameterError
-from sila_labware.sila_glue import handover_position, validation_error
+from sila_labware.sila_glue import COMMAND_LIFETIME, handover_position, validation_error
 
 from ..generated.labwaretransfersitecontroller import (
     HandoverPosition,
@@ -38,10 +37,10 @@ class LabwareTransferSiteControllerImpl(LabwareTransferSiteControllerBase):
     def __init__(self, parent_server: Server) -> None:
         super().__init__(parent_server=parent_server)
         self.station = parent_server.station
-        self.PrepareForInput_default_lifetime_of_execution = timedelta(minutes=30)
-        self.PrepareForOutput_default_lifetime_of_execution = timedelta(minutes=30)
-        self.LabwareDelivered_default_lifetime_of_execution = timedelta(minutes=30)
-        self.LabwareRemoved_default_lifetime_of_execution = timedelta(minutes=30)
+        self.PrepareForInput_default_lifetime_of_execution = COMMAND_LIFETIME
+        self.PrepareForOutput_default_lifetime_of_execution = COMMAND_LIFETIME
+        self.LabwareDelivered_default_lifetime_of_execution = COMMAND_LIFETIME
+        self.LabwareRemoved_default_lifetime_of_execution = COMMAND_LIFETIME
 
     def get_AvailableHandoverPositions(self, *, metadata: MetadataDict) -> list[HandoverPosition]:
         return [handover_position(name, count) for name, count in self.station.handover_positions()]
