@@ -105,7 +105,11 @@ def main() -> int:
     parser.add_argument("--feedback-period-s", type=float, default=0.02)
     args = parser.parse_args()
     rclpy.init()
-    node = LatencyPeer(args.feedbacks, args.feedback_period_s)
+    return serve_node(LatencyPeer(args.feedbacks, args.feedback_period_s))
+
+
+def serve_node(node: Node) -> int:
+    """Spin a stand-in peer until SIGINT/SIGTERM; print READY first, for the parent waiting on it."""
     executor = MultiThreadedExecutor(num_threads=4)
     executor.add_node(node)
     print("READY", flush=True)

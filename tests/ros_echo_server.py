@@ -19,8 +19,9 @@ from labware_interfaces.msg import ErrorCodes, RobotState, StationInfo
 from labware_interfaces.srv import DescribeWorkcell
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
-from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 from rclpy.node import Node
+
+from ros_bridge.latency_peer import serve_node
 
 
 class EchoRobot(Node):
@@ -106,19 +107,7 @@ def main() -> int:
     parser.add_argument("--goal-seconds", type=float, default=1.0)
     args = parser.parse_args()
     rclpy.init()
-    node = EchoRobot(args.goal_seconds)
-    executor = MultiThreadedExecutor(num_threads=4)
-    executor.add_node(node)
-    print("READY", flush=True)
-    try:
-        executor.spin()
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        executor.shutdown(timeout_sec=0.5)
-        node.destroy_node()
-        rclpy.try_shutdown()
-    return 0
+    return serve_node(EchoRobot(args.goal_seconds))
 
 
 if __name__ == "__main__":

@@ -178,5 +178,6 @@ def test_demo_without_the_task_servers_exits_1_naming_what_is_missing(
 ) -> None:
     world = Path(__file__).resolve().parents[1] / "tiago_sim" / "worlds" / "default.yaml"
     with caplog.at_level(logging.ERROR, logger="ros_bridge.bluesky.demo"):
-        assert run_bluesky_demo(world, ready_timeout_s=1.0) == 1
+        # 3 s: enough for a fresh participant to discover the echo server's navigate action
+        assert run_bluesky_demo(world, ready_timeout_s=3.0) == 1
     assert "action server /dock (Dock) not available" in caplog.text
