@@ -62,7 +62,12 @@ class DiffDriveBase:
         self.w_cmd = min(max(w, -rm.MAX_ANGULAR_SPEED), rm.MAX_ANGULAR_SPEED)
 
     def stopped(self) -> bool:
-        return abs(self.v) < 1e-3 and abs(self.w) < 1e-3
+        """The command has ramped to zero and the base itself stands still (it lags the command,
+        so a drive that reports "stopped" on the command alone would still be rolling)."""
+        if abs(self.v) >= 1e-3 or abs(self.w) >= 1e-3:
+            return False
+        forward, turn = self.body.base_twist()
+        return abs(forward) < 0.005 and abs(turn) < 0.01
 
     def update(self, dt: float) -> None:
         """Before the physics step: accelerate towards the command and move the constraint pivot."""
