@@ -194,7 +194,7 @@ class ActionCaller:
         self.action_type = action_type
         self.action_name = action_name
         self._client: ActionClient = runtime.call(
-            lambda: ActionClient(runtime.node, action_type, action_name)
+            lambda: runtime.own(ActionClient(runtime.node, action_type, action_name))
         )
 
     def is_ready(self) -> bool:

@@ -49,6 +49,7 @@ class RosRuntime:
         )
         self._wake = None
         self._stopping = threading.Event()
+        self._owned: list[Any] = []  # entities the node does not destroy itself (action clients)
 
     @property
     def node(self) -> Node:
@@ -60,6 +61,12 @@ class RosRuntime:
     @property
     def running(self) -> bool:
         return self._thread is not None and self._thread.is_alive() and not self._stopping.is_set()
+
+    def own(self, entity: T) -> T:
+        """Destroy `entity` (anything with `destroy()`) with the node: rclpy's destroy_node skips
+        action clients, and one left alive keeps the node's DDS participant alive with it."""
+        self._owned.append(entity)
+        return entity
 
     def on_ros_thread(self) -> bool:
         return threading.current_thread() is self._thread
@@ -85,24 +92,32 @@ class RosRuntime:
         return self
 
     def stop(self, timeout_s: float = 3.0) -> None:
-        """Shut the context down and join the ROS thread. Safe to call twice."""
+        """Stop the ROS thread, destroy the node, then shut the context down. Safe to call twice.
+
+        Order matters: the node is destroyed while its context is still valid, so its DDS entities
+        and participant go at once (destroyed after shutdown they linger until garbage collection,
+        and a process that starts runtime after runtime, like the bench, piles up participants)."""
         if self._thread is None or self._stopping.is_set():
             return
         self._stopping.set()
         assert self._context is not None and self._executor is not None and self._node is not None
-        try:
-            self._context.try_shutdown()
-        except Exception:  # noqa: BLE001 - shutting down; nothing left to report to
-            logger.debug("context shutdown raised", exc_info=True)
-        self._thread.join(timeout_s)
+        self._thread.join(timeout_s)  # the spin loop checks the flag every 0.1 s
         if self._thread.is_alive():
             logger.warning("the ROS thread did not stop within %.1f s", timeout_s)
         self._fail_pending_calls()
         try:
             self._executor.shutdown(timeout_sec=0.5)
+            for entity in self._owned:
+                entity.destroy()
+            self._owned.clear()
             self._node.destroy_node()
-        except Exception:  # noqa: BLE001
+        except Exception:  # noqa: BLE001 - shutting down; nothing left to report to
             logger.debug("node teardown raised", exc_info=True)
+        try:
+            self._context.try_shutdown()
+            self._context.destroy()
+        except Exception:  # noqa: BLE001
+            logger.debug("context shutdown raised", exc_info=True)
         logger.info("ROS runtime %s stopped", self._node_name)
 
     def __enter__(self) -> RosRuntime:
