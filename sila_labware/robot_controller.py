@@ -216,6 +216,7 @@ class RobotController:
         self._motion(
             "DriveToPointOfInterest", lambda: self.link.navigate_to_poi(poi, _ScaledReport(report, 0, 1))
         )
+        self._await_arrival_report(poi)
 
     def stop_motion(self) -> bool:
         """Cancel whatever goal runs; True if one was running."""
@@ -248,6 +249,14 @@ class RobotController:
         finally:
             self.sequence.finish_motion()
 
+    def _await_arrival_report(self, poi: str, timeout_s: float = 2.0) -> None:
+        """After a drive succeeded, wait until /robot_state says the robot is at `poi`, so that the
+        command ends with CurrentPointOfInterest already true (the state topic lags results)."""
+        try:
+            self.link.wait_for_robot_status(lambda status: status.current_poi == poi, timeout_s)
+        except BridgeTimeout:
+            logger.warning("drive to %s succeeded but the robot state does not report it yet", poi)
+
     def _drive_for_transfer(self, handover: Handover, report: ProgressReport | None) -> None:
         """Undock if needed, then drive to the station's POI (unless already there)."""
         success = False
@@ -268,6 +277,7 @@ class RobotController:
                     raise MotionFailed(
                         outcome.error_code, _describe_failure(f"driving to {station.poi}", outcome)
                     )
+                self._await_arrival_report(station.poi)
             if report is not None:
                 report(1.0, 0.0)
             success = True
