@@ -187,8 +187,7 @@ class RobotController:
                 intermediate_actions,
             )
             send = self.link.get_labware if getting else self.link.put_labware
-            goal = send(request, _ScaledReport(report, 0.0, 1.0))
-            outcome = self._wait(goal, command)
+            outcome = self._wait(lambda: send(request, _ScaledReport(report, 0.0, 1.0)), command)
             labware_id = transfer.labware_id or str(getattr(outcome.result, "labware_id", ""))
             self._settle(labware_id, transfer, outcome, expect_aboard=getting)
             if not outcome.success:
@@ -201,9 +200,11 @@ class RobotController:
 
     def dock(self, report: ProgressReport | None = None) -> None:
         self._motion("Dock", lambda: self.link.dock(_ScaledReport(report, 0.0, 1.0)))
+        self._await_state_report(lambda status: status.docked, "docked")
 
     def undock(self, report: ProgressReport | None = None) -> None:
         self._motion("Undock", lambda: self.link.undock(_ScaledReport(report, 0.0, 1.0)))
+        self._await_state_report(lambda status: not status.docked, "undocked")
 
     def drive_to_poi(self, poi: str, report: ProgressReport | None = None) -> None:
         check_text(poi, "PointOfInterest", allow_empty=False)
@@ -243,19 +244,25 @@ class RobotController:
     def _motion(self, command: str, send: Callable[[], ActionGoal]) -> None:
         self.sequence.begin_motion(command)
         try:
-            outcome = self._wait(send(), command)
+            outcome = self._wait(send, command)
             if not outcome.success:
                 raise MotionFailed(outcome.error_code, _describe_failure(command, outcome))
         finally:
             self.sequence.finish_motion()
 
-    def _await_arrival_report(self, poi: str, timeout_s: float = 2.0) -> None:
-        """After a drive succeeded, wait until /robot_state says the robot is at `poi`, so that the
-        command ends with CurrentPointOfInterest already true (the state topic lags results)."""
+    def _await_arrival_report(self, poi: str) -> None:
+        self._await_state_report(lambda status: status.current_poi == poi, f"at {poi}")
+
+    def _await_state_report(
+        self, shows: Callable[[RobotStatus], bool], what: str, timeout_s: float = 2.0
+    ) -> None:
+        """After a base motion succeeded, wait until /robot_state shows its effect, so that the
+        command ends with the state properties (and the next command's checks) already true: the
+        state topic lags action results."""
         try:
-            self.link.wait_for_robot_status(lambda status: status.current_poi == poi, timeout_s)
+            self.link.wait_for_robot_status(shows, timeout_s)
         except BridgeTimeout:
-            logger.warning("drive to %s succeeded but the robot state does not report it yet", poi)
+            logger.warning("the motion succeeded but the robot state does not report %s yet", what)
 
     def _drive_for_transfer(self, handover: Handover, report: ProgressReport | None) -> None:
         """Undock if needed, then drive to the station's POI (unless already there)."""
@@ -266,13 +273,15 @@ class RobotController:
             status = self.link.robot_status()
             start = 0.0
             if status.docked:
-                outcome = self._wait(self.link.undock(_ScaledReport(report, 0.0, 0.2)), "Undock")
+                outcome = self._wait(lambda: self.link.undock(_ScaledReport(report, 0.0, 0.2)), "Undock")
                 if not outcome.success:
                     raise MotionFailed(outcome.error_code, _describe_failure("Undock", outcome))
                 start = 0.2
             if status.current_poi != station.poi or status.docked:
-                goal = self.link.navigate_to_poi(station.poi, _ScaledReport(report, start, 1.0))
-                outcome = self._wait(goal, "NavigateToPoi")
+                outcome = self._wait(
+                    lambda: self.link.navigate_to_poi(station.poi, _ScaledReport(report, start, 1.0)),
+                    "NavigateToPoi",
+                )
                 if not outcome.success:
                     raise MotionFailed(
                         outcome.error_code, _describe_failure(f"driving to {station.poi}", outcome)
@@ -284,9 +293,14 @@ class RobotController:
         finally:
             self.sequence.finish_prepare(success)
 
-    def _wait(self, goal: ActionGoal, what: str) -> ActionOutcome:
-        """The goal's outcome; bridge trouble (no answer, rejection, timeout) becomes a failed outcome,
-        so that callers always settle the inventory and raise their own defined error."""
+    def _wait(self, send: Callable[[], ActionGoal], what: str) -> ActionOutcome:
+        """Send the goal and return its outcome; bridge trouble (no answer, rejection, timeout, even
+        while sending) becomes a failed outcome, so that callers always settle the inventory and
+        raise their own defined error."""
+        try:
+            goal = send()
+        except BridgeError as error:
+            return ActionOutcome(False, type(error).__name__, f"{what} could not be sent: {error}", "")
         with self._active_lock:
             self._active_goal = goal
         try:

@@ -211,9 +211,13 @@ def test_second_motion_while_busy_is_refused_and_cancel_stops_safely(robot: RosC
     handle = robot.send(GetLabware, "/get_labware", task_goal(GetLabware, "station_a", 1, 2))
     assert handle.accepted
     outcome = handle.outcome
+    ended = handle.get_result_async()
     robot.wait_for(
-        lambda: any("approach" in f.phase for f in outcome.feedback), TASK_TIMEOUT_S, "the approach phase"
+        lambda: ended.done() or any("approach" in f.phase for f in outcome.feedback),
+        TASK_TIMEOUT_S,
+        "the approach phase",
     )
+    assert not ended.done(), f"GetLabware ended before its approach: {ended.result().result.message}"
     busy = robot.call_action(PlayMotion, "/play_motion", PlayMotion.Goal(motion_name="Home"), timeout_s=30.0)
     assert busy.result.error_code == ErrorCodes.BUSY, busy.result.message
     busy_task = robot.call_action(GetLabware, "/get_labware", task_goal(GetLabware, "station_b", 1, 1))

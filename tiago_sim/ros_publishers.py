@@ -2,7 +2,7 @@
 
 A wall-clock timer (executor thread) takes one snapshot of the robot's own sensors from the sim
 thread and publishes it; nothing here touches PyBullet directly. /robot_state goes out when it
-changes and at 2 Hz; /station_states at 2 Hz; the head camera only while someone subscribes.
+changes and at 2 Hz; /station_states likewise; the head camera only while someone subscribes.
 Lives on: the rclpy executor threads of the sim node.
 """
 
@@ -132,6 +132,7 @@ class StatePublishers:
         self.image_pub = node.create_publisher(Image, CAMERA_IMAGE_TOPIC, 2)
         self.info_pub = node.create_publisher(CameraInfo, CAMERA_INFO_TOPIC, 2)
         self._last_robot_key: tuple | None = None
+        self._last_nests: tuple | None = None
         self._last_slow_publish = 0.0
         self._pending: Any = None
         self._camera_pending: Any = None
@@ -170,12 +171,17 @@ class StatePublishers:
         if key != self._last_robot_key or slow_due:
             self.robot_state_pub.publish(state)
             self._last_robot_key = key
+        # A nest that fills or empties is news too: the sequencer checks the source nest from this
+        # topic, and a GetLabware sent right after a place must not read the nest as still empty.
+        nests = tuple(snapshot.nests)
+        if nests != self._last_nests or slow_due:
+            self.station_pub.publish(self.station_states(snapshot))
+            self._last_nests = nests
         if slow_due:
             self._last_slow_publish = now
             if snapshot.true_base_pose is not None:
                 x, y, yaw = snapshot.true_base_pose
                 self.truth_pub.publish(Pose2D(x=x, y=y, theta=yaw))
-            self.station_pub.publish(self.station_states(snapshot))
 
     def _publish_odometry(self, snapshot: RobotSnapshot, stamp: Time) -> None:
         x, y, yaw = snapshot.odometry
