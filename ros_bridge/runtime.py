@@ -140,12 +140,23 @@ class RosRuntime:
         return result
 
     def call(self, call: Callable[[], T], timeout_s: float = 5.0) -> T:
-        """Run `call` on the ROS thread and wait for its return value."""
+        """Run `call` on the ROS thread and wait for its return value.
+
+        A call the ROS thread has not started within `timeout_s` is withdrawn, so that a goal whose
+        sending was reported as failed can never be sent later behind the caller's back."""
         future = self.submit(call)
         try:
             return future.result(timeout=timeout_s)
         except concurrent.futures.TimeoutError as error:
-            raise BridgeTimeout(f"the ROS thread did not answer within {timeout_s:.1f} s") from error
+            if future.cancel():
+                raise BridgeTimeout(
+                    f"the ROS thread did not answer within {timeout_s:.1f} s (the call was withdrawn)"
+                ) from error
+        try:  # it started just now: let it finish rather than leave its effect unknown
+            return future.result(timeout=timeout_s)
+        except concurrent.futures.TimeoutError as error:
+            waited = 2 * timeout_s
+            raise BridgeTimeout(f"the ROS thread did not finish a call within {waited:.1f} s") from error
 
     def _drain_pending_calls(self) -> None:
         while True:

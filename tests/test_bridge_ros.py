@@ -15,7 +15,7 @@ from labware_interfaces.msg import RobotState
 from labware_interfaces.srv import DescribeWorkcell
 
 from ros_bridge.actions import ActionCaller, GoalProgress
-from ros_bridge.errors import BridgeError, ServerUnavailable
+from ros_bridge.errors import BridgeError, BridgeTimeout, ServerUnavailable
 from ros_bridge.runtime import RosRuntime
 from ros_bridge.services import ServiceCaller
 from ros_bridge.topics import TopicMirror
@@ -138,3 +138,15 @@ def test_stopped_runtime_refuses_work() -> None:
     assert time.monotonic() - started < 2.0
     with pytest.raises(BridgeError, match="not running"):
         runtime.call(lambda: None)
+
+
+def test_call_the_ros_thread_never_started_is_withdrawn(runtime: RosRuntime) -> None:
+    """A stalled ROS thread: the caller gets BridgeTimeout and the queued call never runs later
+    (else a goal reported as not sent could still reach the robot)."""
+    stall = runtime.submit(lambda: time.sleep(1.0))
+    ran: list[bool] = []
+    with pytest.raises(BridgeTimeout, match="withdrawn"):
+        runtime.call(lambda: ran.append(True), timeout_s=0.2)
+    stall.result(timeout=5.0)
+    assert runtime.call(lambda: "alive") == "alive"
+    assert ran == [], "the withdrawn call ran after its caller gave up"
