@@ -3,6 +3,8 @@
 Why: with the POI at the working distance, a base stopping 3 to 9 cm long swept the onboard hotel
 into the bench during its final turn and knocked the plate out (campaign seeds 100, 105). The POI
 now lies farther back; the marker-guided final approach (tiago_sim.base_alignment) does the rest.
+Odometry drift adds to the navigation error (seed 2041 stopped 18 cm long at 0.62 m: the tray hit
+the table during the turn), so the POI lies 0.72 m from the nests.
 Real PyBullet, no mocks.
 """
 
@@ -29,9 +31,11 @@ def _closest_to_table(sim: Simulation, station: str) -> float:
     return min((point[8] for point in points), default=0.5)
 
 
-@pytest.mark.parametrize("forward_error_m", [0.0, 0.09])
+@pytest.mark.parametrize("forward_error_m", [0.0, 0.09, 0.18])
 def test_a_long_stop_at_the_poi_keeps_the_hotel_off_the_table(forward_error_m):
-    """3 sigma of the default navigation error, then the turn to the station's heading."""
+    """3 sigma of the default navigation error, and the 18 cm of campaign seed 2041 (8 cm of it
+    navigation error, 10 cm odometry drift over the two drives), then the turn to the station's
+    heading."""
     world = load_world()
     world = dataclasses.replace(world, plates=(InitialPlate(PLATE, "sbs_microplate_96", hotel_slot=1),))
     sim = Simulation(world, seed=3)

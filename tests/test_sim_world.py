@@ -37,7 +37,7 @@ def test_work_poi_stands_in_front_of_the_nests_facing_them():
         T_world_base = world.pois[station.poi].matrix()
         for sub in range(1, station.sub_positions + 1):
             T_base_site = tf.invert(T_world_base) @ station.T_world_site(sub)
-            assert 0.45 <= T_base_site[0, 3] <= 0.65
+            assert 0.55 <= T_base_site[0, 3] <= 0.80  # the POI: behind the working pose (0.45 .. 0.55)
             assert T_base_site[1, 3] < 0.0  # on the right arm's side
             assert T_base_site[2, 3] == pytest.approx(station.table_size[2])
 
@@ -88,7 +88,7 @@ def test_moving_a_station_is_a_yaml_edit(tmp_path):
     site = station.T_world_site(1)
     T_base_site = tf.invert(world.pois[station.poi].matrix()) @ site
     assert math.degrees(world.pois[station.poi].yaw) == pytest.approx(45.0)
-    assert T_base_site[0, 3] == pytest.approx(0.62, abs=1e-6)  # navigation stops at the standoff
+    assert T_base_site[0, 3] == pytest.approx(0.72, abs=1e-6)  # navigation stops at the standoff
     T_work_site = tf.invert(station.aligned_pose().matrix()) @ site
     assert T_work_site[0, 3] == pytest.approx(0.5, abs=1e-6)  # the final approach ends at work_standoff
 

@@ -4,9 +4,10 @@ Why: navigation ends a few centimetres and degrees off its goal (localisation er
 onboard hotel tray reaches 0.33 m ahead of the base centre. Standing at the working distance
 straight from navigation, a 3 to 9 cm error made the turning base sweep the tray into the table
 and knock the plate out of its pocket (seeds 100 and 105 of the default campaign), or left the
-arm no room to unfold (seed 102). So navigation stops farther back (the station's ``standoff``);
-then the robot looks at the station's marker, works out where the working pose
-(``work_standoff``) really is, and drives the last ~12 cm there. The torso rises to the bench
+arm no room to unfold (seed 102). So navigation stops farther back (the station's ``standoff``,
+0.22 m behind the working pose: navigation error and odometry drift together reached 18 cm at
+seed 2041); then the robot looks at the station's marker, works out where the working pose
+(``work_standoff``) really is, and drives the last ~22 cm there. The torso rises to the bench
 working height and the head turns to the bench during that drive (independent joints overlap).
 
 Only robot knowledge is used: the head camera image and depth, joint readings, odometry and the
