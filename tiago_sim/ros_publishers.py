@@ -78,6 +78,11 @@ def _true_base_pose(sim: Any) -> tuple[float, float, float] | None:
     )
 
 
+def _occupied_nests(nests: tuple) -> str:
+    """'station_a:1=plate_001, ...' for the log: which nests hold which plate."""
+    return ", ".join(f"{station}:{sub}={plate}" for station, sub, occupied, plate in nests if occupied)
+
+
 def stamp_of(sim_time: float) -> Time:
     seconds = math.floor(sim_time)
     return Time(sec=int(seconds), nanosec=int((sim_time - seconds) * 1e9))
@@ -176,6 +181,8 @@ class StatePublishers:
         nests = tuple(snapshot.nests)
         if nests != self._last_nests or slow_due:
             self.station_pub.publish(self.station_states(snapshot))
+            if nests != self._last_nests:
+                log.info("nests at sim %.3f s: %s", snapshot.sim_time, _occupied_nests(nests))
             self._last_nests = nests
         if slow_due:
             self._last_slow_publish = now

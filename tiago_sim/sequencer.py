@@ -42,7 +42,15 @@ from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.task import Future
 
 from tiago_sim.node_main import spin_node
-from tiago_sim.task_plans import Step, TaskRefused, Workcell, get_plan, put_plan, retreat_after_empty_grasp
+from tiago_sim.task_plans import (
+    STATE_REFUSALS,
+    Step,
+    TaskRefused,
+    Workcell,
+    get_plan,
+    put_plan,
+    retreat_after_empty_grasp,
+)
 
 log = logging.getLogger("tiago_sim.sequencer")
 
@@ -194,6 +202,28 @@ class Sequencer:
         assert self.robot_state is not None and self.station_states is not None
         return self.robot_state, self.station_states
 
+    async def _plan(self, request: Any, make_plan: Any, arrived: float) -> list[Step]:
+        """The goal's steps, or TaskRefused. A refusal read from the state topics (slot or nest full
+        or empty) must also hold in states received after the goal arrived: a plate placed just
+        before the goal can be missing from an older message."""
+        workcell = await self._describe()
+        await self._wait_ready("/robot_state and /station_states", lambda: len(self.state_times) == 2)
+
+        def plan() -> list[Step]:
+            robot_state, station_states = self._fresh_states()
+            return make_plan(request, workcell, robot_state, station_states, str(self.param("arm")))
+
+        try:
+            return plan()
+        except TaskRefused as refusal:
+            if refusal.code not in STATE_REFUSALS or min(self.state_times.values()) > arrived:
+                raise
+            log.info("%s read from states older than the goal: reading fresh ones", refusal.code)
+        await self._wait_ready(
+            "/robot_state and /station_states", lambda: min(self.state_times.values()) > arrived
+        )
+        return plan()
+
     def _execute(self, kind: Any, make_plan: Any) -> Any:
         async def execute(goal_handle: Any) -> Any:
             result = kind.Result()
@@ -201,11 +231,7 @@ class Sequencer:
             if self.active is not None:
                 return self._finish(goal_handle, result, ErrorCodes.BUSY, "busy with another transfer")
             try:
-                workcell = await self._describe()
-                await self._wait_ready("/robot_state and /station_states", lambda: len(self.state_times) == 2)
-                robot_state, station_states = self._fresh_states()
-                arm = str(self.param("arm"))
-                plan = make_plan(goal_handle.request, workcell, robot_state, station_states, arm)
+                plan = await self._plan(goal_handle.request, make_plan, arrived=time.monotonic())
             except (TaskRefused, StepFailed) as refusal:
                 return self._finish(goal_handle, result, refusal.code, refusal.message)
             result.labware_id = self._labware_id(goal_handle.request, kind is PutLabware)

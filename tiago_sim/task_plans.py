@@ -12,6 +12,11 @@ from typing import Any
 
 from labware_interfaces.msg import ErrorCodes, RobotState
 
+# Refusals that rest on what the state topics say (a slot or nest full or empty), not on the goal.
+STATE_REFUSALS = frozenset(
+    {ErrorCodes.SLOT_OCCUPIED, ErrorCodes.GRASP_FAILED, ErrorCodes.NEST_OCCUPIED, ErrorCodes.SLOT_EMPTY}
+)
+
 
 class TaskRefused(Exception):
     """The goal cannot be done; nothing has moved yet."""
