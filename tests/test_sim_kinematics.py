@@ -19,7 +19,9 @@ def kinematics() -> RobotKinematics:
     return RobotKinematics()
 
 
-def test_ik_reaches_every_nest_from_its_work_poi_and_both_hotel_slots(kinematics):
+def test_ik_reaches_every_nest_from_its_working_pose_and_both_hotel_slots(kinematics):
+    """From where the marker-guided final approach parks the base (`work_standoff`), not from the
+    POI where navigation stops (farther back, out of the hotel's sweep)."""
     world = load_world()
     seed = {
         "torso_lift_joint": 0.15,
@@ -27,7 +29,7 @@ def test_ik_reaches_every_nest_from_its_work_poi_and_both_hotel_slots(kinematics
     }
     targets = []
     for station in world.stations:
-        T_world_base = world.pois[station.poi].matrix()
+        T_world_base = station.aligned_pose().matrix()
         for sub in range(1, station.sub_positions + 1):
             T_base_site = tf.invert(T_world_base) @ station.T_world_site(sub)
             for lift in (0.0, station.approach_height):

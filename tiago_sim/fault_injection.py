@@ -91,10 +91,12 @@ class PlateFaults:
         log.info("plate %s will slip out of the hotel during the next drive (fault injection)", labware_id)
 
     def drop_if_driving(self, sim: Any) -> bool:
-        """Called on the sim thread while a drop is armed: push the plate off the tray once the base
-        drives with it aboard; True when it did."""
+        """Called on the sim thread after every batch of steps while a drop is armed: push the plate
+        off the tray once the base drives with it aboard; True when done (dropped, or disarmed)."""
         labware_id = self.drop_armed
-        if not labware_id or abs(sim.base.v) < DRIVING_SPEED_M_S:
+        if not labware_id:
+            return True
+        if abs(sim.base.v) < DRIVING_SPEED_M_S:
             return False
         slot = next((index for index, found, _ in sim.hotel_occupancy() if found == labware_id), 0)
         if not slot:

@@ -12,7 +12,7 @@ import logging
 import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 from builtin_interfaces.msg import Time
@@ -46,6 +46,7 @@ class RobotSnapshot:
     held_labware_id: str
     nests: list[tuple[str, int, bool, str]] = field(default_factory=list)
     true_base_pose: tuple[float, float, float] | None = None  # simulator truth, for measurement only
+    activity: tuple[str, str] = ("", "")  # (state or "", detail) of the action servers at that instant
 
 
 def take_snapshot(sim: Any) -> RobotSnapshot:
@@ -151,7 +152,12 @@ class StatePublishers:
             return  # the sim thread is still answering the previous request
         if self._pending is not None and self._pending.exception() is None:
             self._publish(self._pending.result())
-        self._pending = self.sim_thread.call(take_snapshot)
+        self._pending = self.sim_thread.call(self._snapshot_with_activity)
+
+    def _snapshot_with_activity(self, sim: Any) -> RobotSnapshot:
+        """Sensors and activity read at the same instant (on the sim thread): a state read later
+        than the pose said "idle" beside the pose of a base still braking (10 cm off, under load)."""
+        return replace(take_snapshot(sim), activity=self.activity())
 
     def _publish(self, snapshot: RobotSnapshot) -> None:
         self.latest = snapshot
@@ -211,7 +217,7 @@ class StatePublishers:
         self.odom_pub.publish(odom)
 
     def robot_state(self, snapshot: RobotSnapshot) -> RobotState:
-        activity, detail = self.activity()
+        activity, detail = snapshot.activity
         message = RobotState()
         message.stamp = stamp_of(snapshot.sim_time)
         if activity:

@@ -86,7 +86,6 @@ class SimNode:
         node.create_service(DescribeWorkcell, "/describe_workcell", self._describe_workcell)
         node.create_service(CheckPlacement, "/check_placement", self._check_placement)
         node.add_on_set_parameters_callback(self._on_parameters)
-        node.create_timer(0.05, self._watch_armed_drop)
 
     # -- parameters ------------------------------------------------------------------------
     def _declare_parameters(self) -> None:
@@ -147,11 +146,9 @@ class SimNode:
             self.plate_faults.remove(sim, labware_id)
         else:
             self.plate_faults.arm_drop(sim, labware_id)
-
-    def _watch_armed_drop(self) -> None:
-        """Timer: while a drop is armed, let the sim thread check whether the base drives now."""
-        if self.plate_faults.drop_armed:
-            self.sim_thread.call(self.plate_faults.drop_if_driving)
+            # Checked after every batch of steps: a wall-clock timer could miss a fast drive (seen
+            # under CI load: a 1 s drive went by without the check seeing the base at speed).
+            self.sim_thread.watch(self.plate_faults.drop_if_driving)
 
     def current_pois(self) -> dict[str, tuple[float, float, float]]:
         pois = {}

@@ -43,6 +43,8 @@ class SimThread:
         self._jobs: queue.SimpleQueue[tuple[Callable[[Any], Any], Future]] = queue.SimpleQueue()
         self._stop = threading.Event()
         self._ready: Future = Future()
+        # Checks that must see every batch of steps (not a wall-clock sample of them); sim thread only.
+        self._watchers: list[Callable[[Any], bool]] = []
         self.realtime_factor_cap = realtime_factor_cap
         self.idle_realtime_factor = idle_realtime_factor
         self.sim_time = 0.0  # copy of sim.sim_time, readable from any thread
@@ -79,6 +81,14 @@ class SimThread:
     def run(self, job: Callable[[Any], T], timeout_s: float = 30.0) -> T:
         """`call` and wait for the result."""
         return self.call(job).result(timeout=timeout_s)
+
+    def watch(self, watcher: Callable[[Any], bool]) -> None:
+        """Run `watcher(sim)` on the sim thread after every batch of steps (at most
+        _STEPS_BETWEEN_JOB_CHECKS steps apart, whatever the load) until it returns True."""
+        self.call(lambda _sim: self._watchers.append(watcher))
+
+    def _run_watchers(self, sim: Any) -> None:
+        self._watchers = [watcher for watcher in self._watchers if not watcher(sim)]
 
     def _run_jobs(self, sim: Any) -> None:
         while True:
@@ -121,6 +131,8 @@ class SimThread:
             while not self._stop.is_set():
                 cpu_before = time.thread_time()
                 self._run_jobs(sim)
+                if self._watchers:
+                    self._run_watchers(sim)
                 cpu_after_jobs = time.thread_time()
                 self.job_cpu_s += cpu_after_jobs - cpu_before
                 if sim.busy():
