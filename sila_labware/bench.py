@@ -28,7 +28,7 @@ from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any, TextIO
 
-from sila_labware.demo import DemoReport, run_demo
+from sila_labware.demo import MISPLACED, DemoReport, run_demo
 from sila_labware.deployment import Deployment, DeploymentOptions
 
 logger = logging.getLogger(__name__)
@@ -92,6 +92,8 @@ def default_level_values(scale: float = 1.0) -> dict[str, float]:
 def classify_failure(report: DemoReport) -> str:
     """Failure cause of one trial from what the SiLA commands and the placement check said."""
     error = report.error
+    if error.startswith(MISPLACED):  # the commands succeeded, the physics check disagrees
+        return "positioning"
     for code, cause in CAUSE_BY_ERROR_CODE.items():
         if code in error:
             return cause
@@ -99,8 +101,6 @@ def classify_failure(report: DemoReport) -> str:
         return "navigation" if any(word in error for word in BASE_MOTION_WORDS) else "positioning"
     if any(word in error for word in BASE_MOTION_WORDS):
         return "navigation"
-    if "is not in" in error:  # the commands succeeded, the physics check disagrees
-        return "positioning"
     return "other"
 
 

@@ -21,6 +21,7 @@ from typing import Any, TextIO
 
 from sila2.client import SilaClient
 
+from ros_bridge.workcell import PlacementCheck
 from sila_labware.deployment import Deployment, ServedServer
 
 logger = logging.getLogger(__name__)
@@ -172,5 +173,21 @@ def run_demo(deployment: Deployment, progress_stream: TextIO | None = sys.stderr
         report.plate_position_error_mm = 1000.0 * placement.position_error_m
         report.plate_yaw_error_deg = math.degrees(placement.yaw_error_rad)
     if not placement.in_nest and not report.error:
-        report.error = f"the plate is not in {report.destination}; it is at {placement.location}"
+        report.error = misplacement(report.destination, placement)
     return report
+
+
+# Starts every error of a transfer whose commands succeeded but whose plate physics finds misplaced.
+MISPLACED = "physics check: "
+
+
+def misplacement(destination: str, placement: PlacementCheck) -> str:
+    """Why the physics check refused a delivery the commands reported as done."""
+    station, _, sub = destination.partition("/")
+    if placement.location != f"station:{station}:{sub}":
+        return f"{MISPLACED}the plate is not in {destination}; it is at {placement.location}"
+    return (
+        f"{MISPLACED}the plate rests in {destination} but outside the nest's tolerance: "
+        f"{1000.0 * placement.position_error_m:.1f} mm from the centre, yaw "
+        f"{math.degrees(placement.yaw_error_rad):.1f} deg (a raised or tilted plate is outside too)"
+    )

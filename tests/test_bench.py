@@ -81,7 +81,8 @@ def test_disturbances_are_seeded_and_move_the_true_world_only() -> None:
         ("driving to station_b_work failed (NAVIGATION_FAILED): blocked", "navigation"),
         ("Undock failed (MOTION_FAILED): stalled", "navigation"),
         ("PutLabware failed (IK_FAILED): no solution", "positioning"),
-        ("the plate is not in station_b/1; it is at table station_b", "positioning"),
+        ("physics check: the plate is not in station_b/1; it is at floor", "positioning"),
+        ("physics check: the plate rests in station_b/1 but outside the nest's tolerance", "positioning"),
         ("TimeoutError: Robot.GetLabware: not finished after 900 s", "other"),
     ],
 )
