@@ -8,6 +8,7 @@ by the caller. Lives on: an rclpy executor thread (one per goal).
 
 from __future__ import annotations
 
+import concurrent.futures
 import logging
 import threading
 import time
@@ -19,6 +20,10 @@ from labware_interfaces.msg import ErrorCodes
 from tiago_sim.sim_thread import SimThread
 
 log = logging.getLogger(__name__)
+
+# Longest wait between looks at cancel requests and feedback while a job or motion runs; the end
+# of either wakes the waiting thread at once.
+_POLL_S = 0.02
 
 
 class ActionAbort(Exception):
@@ -96,12 +101,14 @@ class ActionRun:
         """Run a job on the sim thread and wait, sending feedback while waiting."""
         future = self.sim_thread.call(job)
         deadline = time.monotonic() + timeout_s
-        while not future.done():
+        while True:
+            try:
+                return future.result(timeout=_POLL_S)  # returns the moment the job is done
+            except concurrent.futures.TimeoutError:
+                pass
             if time.monotonic() > deadline or self.sim_thread.stopped:
                 raise ActionAbort(ErrorCodes.INTERNAL, "simulation did not answer in time")
             self.feedback(self.progress, self.phase, self.remaining_s)
-            time.sleep(0.02)
-        return future.result()
 
     def run_motion(
         self,
@@ -138,7 +145,7 @@ class ActionRun:
             self.feedback(
                 low + (high - low) * fraction, str(motion.phase), float(motion.remaining_s) + later_s
             )
-            time.sleep(0.02)
+            motion.finished.wait(_POLL_S)
         if cancel_sent and self.canceled():
             raise ActionAbort(ErrorCodes.CANCELED, f"canceled during {motion.name}: stopped safely")
         if cancel_sent:

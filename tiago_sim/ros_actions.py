@@ -105,7 +105,7 @@ class RobotActionServers:
             run = ActionRun(goal_handle, action_type.Feedback, self.sim_thread, feedback_hz=self.feedback_hz)
             result = action_type.Result()
             acquired = False
-            sim_started = self.sim_thread.sim_time
+            sim_started, busy_started = self.sim_thread.sim_time, self.sim_thread.busy_sim_s
             try:
                 self.slot.acquire(name)
                 acquired = True
@@ -132,8 +132,9 @@ class RobotActionServers:
                     self.slot.release()
                 # one line per goal with its simulated span (tiago_sim.benchmark times phases by it)
                 log.info(
-                    "%s %s: sim %.3f .. %.3f s",
+                    "%s %s: sim %.3f .. %.3f s, %.3f s of it with no motion running",
                     name, result.error_code or "done", sim_started, self.sim_thread.sim_time,
+                    self.sim_thread.sim_time - sim_started - (self.sim_thread.busy_sim_s - busy_started),
                 )  # fmt: skip
             return result
 

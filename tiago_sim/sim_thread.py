@@ -42,6 +42,8 @@ class SimThread:
         self._factory = factory
         self._jobs: queue.SimpleQueue[tuple[Callable[[Any], Any], Future]] = queue.SimpleQueue()
         self._stop = threading.Event()
+        # Set by call() and stop(): a thread pacing an idle robot wakes for a new job at once.
+        self._wake = threading.Event()
         self._ready: Future = Future()
         # Checks that must see every batch of steps (not a wall-clock sample of them); sim thread only.
         self._watchers: list[Callable[[Any], bool]] = []
@@ -67,6 +69,7 @@ class SimThread:
 
     def stop(self, timeout_s: float = 5.0) -> None:
         self._stop.set()
+        self._wake.set()
         self._thread.join(timeout=timeout_s)
 
     def call(self, job: Callable[[Any], T]) -> Future:
@@ -76,6 +79,7 @@ class SimThread:
             future.set_exception(RuntimeError("simulation stopped"))
             return future
         self._jobs.put((job, future))
+        self._wake.set()
         return future
 
     def run(self, job: Callable[[Any], T], timeout_s: float = 30.0) -> T:
@@ -130,6 +134,7 @@ class SimThread:
         try:
             while not self._stop.is_set():
                 cpu_before = time.thread_time()
+                self._wake.clear()  # before draining: a job queued from here on sets it again
                 self._run_jobs(sim)
                 if self._watchers:
                     self._run_watchers(sim)
@@ -158,7 +163,7 @@ class SimThread:
                 # Sleep until wall time catches up with sim time at the chosen factor.
                 ahead_s = (sim.sim_time - sim_start) / factor - (time.monotonic() - wall_start)
                 if ahead_s > 0:
-                    self._stop.wait(min(ahead_s, 0.05))
+                    self._wake.wait(min(ahead_s, 0.05))
                 elif ahead_s < -0.5:  # fell behind (busy phases): do not try to catch up later
                     wall_start, sim_start = time.monotonic(), sim.sim_time
         finally:
@@ -172,6 +177,9 @@ class SimThread:
                 sim.sim_time,
                 time.process_time(),
             )
+            ledger = getattr(sim, "step_ledger", None)
+            if ledger is not None:
+                log.info("physics steps by regime: %s", ledger.summary())
             self._drain_after_stop()
             close = getattr(sim, "close", None)
             if callable(close):

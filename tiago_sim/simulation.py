@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import logging
 import math
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -79,6 +80,30 @@ class PlacementCheck:
     location: str
 
 
+class StepLedger:
+    """Physics steps and the CPU they took, by step length and solver iterations.
+
+    Why: the physics step is most of the sim thread's CPU; which regime eats it tells where a
+    faster simulation has to come from (logged when the sim thread stops)."""
+
+    def __init__(self) -> None:
+        self.entries: dict[tuple[float, int], list[float]] = {}  # -> [steps, sim s, CPU s]
+
+    def record(self, step_s: float, iterations: int, cpu_s: float) -> None:
+        entry = self.entries.setdefault((step_s, iterations), [0, 0.0, 0.0])
+        entry[0] += 1
+        entry[1] += step_s
+        entry[2] += cpu_s
+
+    def summary(self) -> str:
+        rows = sorted(self.entries.items(), key=lambda item: -item[1][2])
+        return "; ".join(
+            f"1/{round(1 / step_s)} s x {iterations} iterations: {int(steps)} steps, "
+            f"{sim_s:.1f} s simulated, {cpu_s:.2f} s CPU ({cpu_s / steps * 1000:.2f} ms/step)"
+            for (step_s, iterations), (steps, sim_s, cpu_s) in rows
+        )
+
+
 class Simulation:
     """PyBullet world + robot; see the module docstring for threading."""
 
@@ -119,6 +144,7 @@ class Simulation:
         self._iterations = SOLVER_ITERATIONS
         self._step = time_step
         self.last_step_s = time_step  # length of the latest physics step (s)
+        self.step_ledger = StepLedger()
         self._reviewed_at = -1.0
         self._carrying = False
         self._plate_within_range = True
@@ -156,7 +182,9 @@ class Simulation:
         if not base_driven:
             self.base.command(0.0, 0.0)  # no drive running: the base brakes and stands
         self.base.update(dt)
+        started = time.thread_time()
         p.stepSimulation(physicsClientId=self.client_id)
+        self.step_ledger.record(dt, self._iterations, time.thread_time() - started)
         self.base.integrate_odometry(dt)
         self.sim_time += dt
         self.last_step_s = dt
