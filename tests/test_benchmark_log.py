@@ -31,7 +31,8 @@ def test_goal_spans_read_start_end_and_time_without_motion(tmp_path: Path) -> No
         tmp_path,
         [
             "tiago_sim.ros_actions: /undock done: sim 4.133 .. 6.833 s, 0.042 s of it with no motion running",
-            "tiago_sim.marker_motion: marker 3 of station_a at [ 0.8 -0.1  0.84 ] in base "
+            "tiago_sim.marker_motion: marker 3 of station_a at [ 0.8 -0.1  0.84 ] in base, "
+            "quaternion [0 0 0 1] "
             "(reprojection 0.09 px)",
             "tiago_sim.ros_actions: /marker_motion MARKER_NOT_FOUND: sim 13.5 .. 18.7 s, 0.342 s of it with "
             "no motion running",
@@ -49,23 +50,28 @@ def test_only_sightings_from_where_the_base_stood_are_compared(
     world = load_world(DEFAULT_WORLD)
     station = world.stations[0]
     base = station.aligned_pose()
-    truth_position = (tf.invert(base.matrix()) @ station.T_world_marker())[:3, 3]
-    seen = truth_position + np.array([0.001, 0.0, 0.0])  # 1 mm off
-    as_logged = " ".join(f"{v:.4f}" for v in seen)
+    truth = tf.invert(base.matrix()) @ station.T_world_marker()
+    # 1 mm off along x and turned 0.5 deg about the marker's own z axis
+    seen = truth @ tf.from_xyz_rpy((0.0, 0.0, 0.0), (0.0, 0.0, np.radians(0.5)))
+    seen[:3, 3] += (0.001, 0.0, 0.0)
+    position = " ".join(f"{v:.4f}" for v in seen[:3, 3])
+    quaternion = " ".join(f"{v:.5f}" for v in tf.matrix_to_quat(seen[:3, :3]))
     sighting = f"tiago_sim.marker_motion: marker {station.marker_id} of {station.name} at"
     log = _write(
         tmp_path,
         [
-            f"{sighting} [ 0.9 -0.1 0.84 ] in base (reprojection 0.09 px)",
+            f"{sighting} [ 0.9 -0.1 0.84 ] in base, quaternion [0.5 -0.5 0.5 -0.5] (reprojection 0.09 px)",
             f"tiago_sim.base_alignment: aligning at {station.name}: working pose at x 0.218 y 0.002 m, "
             "yaw 0.2 deg from here",
-            f"{sighting} [ {as_logged} ] in base (reprojection 0.10 px)",
+            f"{sighting} [ {position} ] in base, quaternion [{quaternion}] (reprojection 0.10 px)",
         ],
     )
-    truth = {station.name: SimpleNamespace(x=base.x, y=base.y, theta=base.yaw)}
-    benchmark._marker_errors(log, world, truth, np, tf)
+    ground_truth = {station.name: SimpleNamespace(x=base.x, y=base.y, theta=base.yaw)}
+    benchmark._marker_errors(log, world, ground_truth, np, tf)
     lines = capsys.readouterr().out.splitlines()
     assert len(lines) == 2
     assert "before the final approach" in lines[0]
-    error_mm = float(lines[1].split("position error ")[1].split()[0])
-    assert error_mm == pytest.approx(1.0, abs=0.1)
+    position_mm = float(lines[1].split("position error ")[1].split()[0])
+    orientation_deg = float(lines[1].split("orientation error ")[1].split()[0])
+    assert position_mm == pytest.approx(1.0, abs=0.1)
+    assert orientation_deg == pytest.approx(0.5, abs=0.02)

@@ -197,7 +197,7 @@ def _marker_errors(log_path: Path, world: Any, truth: dict[str, Any], np: Any, t
     followed by "aligning at" was taken at the POI before the final approach moved the base, so
     that truth does not apply to it; it is counted, not compared.
     """
-    sightings: list[tuple[Any, Any, bool]] = []  # station, position seen, taken before the approach
+    sightings: list[tuple[Any, Any, bool]] = []  # station, T_base_marker seen, taken before the approach
     for line in log_path.read_text().splitlines():
         if "tiago_sim.base_alignment: aligning at " in line:
             name = line.split("aligning at ", 1)[1].split(":")[0]
@@ -207,7 +207,10 @@ def _marker_errors(log_path: Path, world: Any, truth: dict[str, Any], np: Any, t
                     break
         elif "tiago_sim.marker_motion: marker" in line:
             station = world.station(line.split(" of ", 1)[1].split()[0])
-            seen = np.array([float(v) for v in line.split("[")[1].split("]")[0].split()])
+            position, quaternion = (
+                np.array([float(v) for v in part.split("]")[0].split()]) for part in line.split("[")[1:3]
+            )
+            seen = tf.from_pose(position, quaternion)
             sightings.append((station, seen, False))
     for station, seen, before_approach in sightings:
         base = truth.get(station.name)
@@ -218,8 +221,10 @@ def _marker_errors(log_path: Path, world: Any, truth: dict[str, Any], np: Any, t
                   "approach moved the base (no truth for that pose)")  # fmt: skip
             continue
         T_base_marker = tf.invert(tf.from_planar(base.x, base.y, base.theta)) @ station.T_world_marker()
+        angle = tf.rotation_angle(seen[:3, :3], T_base_marker[:3, :3])
         print(f"marker {station.marker_id} ({station.name}): position error "
-              f"{np.linalg.norm(seen - T_base_marker[:3, 3]) * 1000:.2f} mm")  # fmt: skip
+              f"{np.linalg.norm(seen[:3, 3] - T_base_marker[:3, 3]) * 1000:.2f} mm, "
+              f"orientation error {math.degrees(angle):.2f} deg")  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -34,7 +34,7 @@ from tiago_sim.kinematics import RobotKinematics
 from tiago_sim.motion_library import HotelGrasp
 from tiago_sim.perception.aruco import detect_marker
 from tiago_sim.robot_behaviours import TOOL_SPEED_FREE, TOOL_SPEED_INTO_POCKET, RobotBehaviours
-from tiago_sim.transforms import to_pose
+from tiago_sim.transforms import matrix_to_quat, to_pose
 from tiago_sim.world import World
 
 log = logging.getLogger(__name__)
@@ -99,9 +99,9 @@ class MarkerMotionBehaviour:
             observation.reprojection_error_px,
         )
         log.info(
-            "marker %d of %s at %s in base (reprojection %.2f px)",
+            "marker %d of %s at %s in base, quaternion %s (reprojection %.2f px)",
             station.marker_id, station_name, np.round(sighting.T_base_marker[:3, 3], 4),
-            observation.reprojection_error_px,
+            np.round(matrix_to_quat(sighting.T_base_marker[:3, :3]), 5), observation.reprojection_error_px,
         )  # fmt: skip
         self.last_sighting = sighting
         return sighting
