@@ -190,13 +190,23 @@ def run_campaign(
     progress_stream: TextIO | None = sys.stderr,
     on_trial: Callable[[TrialOutcome], None] | None = None,
 ) -> list[TrialOutcome]:
-    """Trials with seeds seed, seed+1, ...; a failure is logged with its seed and the campaign goes on."""
+    """Trials with seeds seed, seed+1, ...; a failure is logged with its seed and the campaign goes on.
+
+    Ctrl-C (or SIGTERM, see the CLI) abandons the running trial, whose robot side and servers are
+    stopped on the way out, and returns the trials done so far: fewer than asked for."""
     progress = CampaignProgress(progress_stream, options.trials)
     outcomes: list[TrialOutcome] = []
     for index in range(options.trials):
         trial_seed = options.seed + index
         record_dir = options.record_dir if index == 0 else None
-        outcome = run_trial(options, trial_seed, record_dir)
+        try:
+            outcome = run_trial(options, trial_seed, record_dir)
+        except KeyboardInterrupt:
+            logger.warning(
+                "interrupted: trial seed %d abandoned, %d of %d trial(s) done",
+                trial_seed, len(outcomes), options.trials,
+            )  # fmt: skip
+            break
         if not outcome.success:
             logger.warning(
                 "trial seed %d failed (%s): %s; replay: sila-labware bench --replay %d",

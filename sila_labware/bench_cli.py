@@ -3,8 +3,8 @@
     sila-labware bench --trials N --seed S [--world FILE] [--json] [--report DIR] [--replay SEED]
                        [--level-scale X] [--nav-error-mm MM ...one flag per disturbance level]
 
-Exit codes: 0 every trial delivered its plate, 1 at least one failed, 2 bad usage.
-Threads: the CLI's main thread.
+Exit codes: 0 every trial delivered its plate, 1 at least one failed, 2 bad usage, 130 stopped by
+Ctrl-C or SIGTERM (the trials done so far are still summarised). Threads: the CLI's main thread.
 """
 
 from __future__ import annotations
@@ -29,6 +29,8 @@ from sila_labware.bench import (
 from sila_labware.deployment import DeploymentOptions
 
 logger = logging.getLogger(__name__)
+
+INTERRUPTED_EXIT_CODE = 130  # the shell's code for a command ended by SIGINT
 
 
 def add_bench_arguments(bench: argparse.ArgumentParser) -> None:
@@ -103,10 +105,17 @@ def bench_command(args: argparse.Namespace, stack: DeploymentOptions) -> int:
         written += write_run_pictures(frames_dir, args.report)
         (args.report / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
         sys.stderr.write("report: " + ", ".join(str(path) for path in written) + "\n")
+    interrupted = len(outcomes) < trials
+    if interrupted:
+        summary["interrupted_after_trials"] = len(outcomes)
     if args.json:
         sys.stdout.write(json.dumps(summary) + "\n")
     else:
+        if interrupted:
+            sys.stdout.write(f"interrupted: {len(outcomes)} of {trials} trial(s) done\n")
         sys.stdout.write(format_table(summary) + "\n\n" + format_targets(summary) + "\n")
+    if interrupted:
+        return INTERRUPTED_EXIT_CODE
     return 0 if summary["successes"] == summary["trials"] else 1
 
 

@@ -279,6 +279,12 @@ def bluesky_demo(args: argparse.Namespace) -> int:
 
 
 def _bench(args: argparse.Namespace) -> int:
+    from sila_labware.processes import interrupt_between_starts
+
+    # Ctrl-C and SIGTERM unwind the running trial: its robot side (own sessions, so a terminal's
+    # Ctrl-C never reaches it) is stopped on the way out instead of being left running.
+    signal.signal(signal.SIGINT, interrupt_between_starts)
+    signal.signal(signal.SIGTERM, interrupt_between_starts)
     return bench_command(args, _deployment_from(args).options)
 
 

@@ -22,6 +22,7 @@ import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from types import FrameType
 from typing import IO
 
 logger = logging.getLogger(__name__)
@@ -74,6 +75,22 @@ class Child:
         return "\n".join(text.splitlines()[-lines:])
 
 
+# Main thread only (signal handlers run there): an interrupt that arrives while a child is being
+# started is held until the child is registered, so the group's stop reaches it.
+_starting_children = 0
+_interrupt_pending = False
+
+
+def interrupt_between_starts(_signum: int, _frame: FrameType | None) -> None:
+    """Signal handler raising KeyboardInterrupt, but never between starting a child (own session,
+    so no terminal signal reaches it) and registering it: that left a sequencer running."""
+    global _interrupt_pending
+    if _starting_children:
+        _interrupt_pending = True
+        return
+    raise KeyboardInterrupt
+
+
 class ProcessGroup:
     """Children started together and stopped together."""
 
@@ -93,19 +110,27 @@ class ProcessGroup:
             output = log_path.open("wb")
         else:
             output = output_file = tempfile.TemporaryFile(prefix=f"sila-labware-{name}-")
-        popen = subprocess.Popen(
-            argv,
-            env=self._environment,
-            stdout=output,
-            stderr=subprocess.STDOUT,
-            stdin=subprocess.DEVNULL,
-            start_new_session=True,
-        )
-        if output_file is None:
-            output.close()  # the child holds its own descriptor
-        child = Child(name, popen, log_path, output_file)
-        self.children.append(child)
+        global _starting_children, _interrupt_pending
+        _starting_children += 1
+        try:
+            popen = subprocess.Popen(
+                argv,
+                env=self._environment,
+                stdout=output,
+                stderr=subprocess.STDOUT,
+                stdin=subprocess.DEVNULL,
+                start_new_session=True,
+            )
+            child = Child(name, popen, log_path, output_file)
+            self.children.append(child)
+        finally:
+            _starting_children -= 1
+            if output_file is None:
+                output.close()  # the child holds its own descriptor
         logger.info("started %s (pid %d): %s", name, popen.pid, " ".join(argv))
+        if _interrupt_pending and not _starting_children:
+            _interrupt_pending = False
+            raise KeyboardInterrupt
         return child
 
     def check_running(self) -> None:

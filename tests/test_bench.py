@@ -9,8 +9,11 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import os
+import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import cv2
@@ -130,3 +133,58 @@ def test_small_campaign_table_is_consistent_replays_and_reports(tmp_path: Path) 
         original["success"],
         original["cause"],
     )
+
+
+def _robot_side_pids(domain_id: str) -> list[int]:
+    """sim_node and sequencer processes of this test run's ROS domain, read from /proc."""
+    pids = []
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            command = (entry / "cmdline").read_bytes()
+            environment = (entry / "environ").read_bytes().split(b"\0")
+        except OSError:
+            continue
+        robot_side = b"tiago_sim.sim_node" in command or b"tiago_sim.sequencer" in command
+        if robot_side and f"ROS_DOMAIN_ID={domain_id}".encode() in environment:
+            pids.append(int(entry.name))
+    return pids
+
+
+def test_sigterm_stops_the_campaign_its_robot_side_and_summarises_what_was_done(tmp_path: Path) -> None:
+    """The robot side runs in sessions of its own (a terminal's Ctrl-C never reaches it): SIGTERM to
+    the bench once left sim_node and sequencer running. Now the running trial is abandoned, its
+    processes stop, and the trials done so far are summarised with exit code 130."""
+    domain_id = os.environ["ROS_DOMAIN_ID"]
+    stack = ["--insecure", "--no-discovery", "--port-base", str(free_port_base(4))]
+    bench = subprocess.Popen(
+        [*CLI, "bench", *stack, "--trials", "3", "--seed", str(SEED), "--json"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert bench.stderr is not None
+        for line in bench.stderr:  # the progress line of the first finished trial
+            if line.startswith("[") and " 1/3 " in line:
+                break
+        else:
+            pytest.fail("the bench ended before its first trial was done")
+        deadline = time.monotonic() + 60
+        while not _robot_side_pids(domain_id):  # the second trial's robot side is up
+            assert time.monotonic() < deadline, "the second trial never started its robot side"
+            time.sleep(0.2)
+        bench.send_signal(signal.SIGTERM)
+        stdout, stderr = bench.communicate(timeout=30)
+    finally:
+        if bench.poll() is None:
+            bench.kill()
+        leftovers = _robot_side_pids(domain_id)
+        for pid in leftovers:  # never leave them to the next test in this ROS domain
+            os.kill(pid, signal.SIGKILL)
+    assert leftovers == [], "the bench left its robot side running"
+    assert bench.returncode == 130, stderr[-2000:]
+    summary = json.loads(stdout)
+    assert summary["trials"] == 1 and summary["interrupted_after_trials"] == 1
+    assert "interrupted: trial seed" in stderr

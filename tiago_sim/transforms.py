@@ -109,6 +109,12 @@ def yaw_of(transform: Matrix4) -> float:
     return float(np.arctan2(transform[1, 0], transform[0, 0]))
 
 
+def levelled(transform: Matrix4) -> Matrix4:
+    """The same origin and heading with z straight up: roll and pitch dropped (a frame on a level bench)."""
+    x, y, z = (float(v) for v in transform[:3, 3])
+    return from_planar(x, y, yaw_of(transform), z)
+
+
 def wrap_angle(angle: float) -> float:
     """Angle wrapped to (-pi, pi]."""
     return float(np.arctan2(np.sin(angle), np.cos(angle)))
