@@ -155,6 +155,7 @@ class RobotLink:
             position_error_m=float(response.position_error_m),
             yaw_error_rad=float(response.yaw_error_rad),
             location=response.location,
+            outside=response.outside,
         )
 
     # --- state topics ---

@@ -82,3 +82,4 @@ class PlacementCheck:
     position_error_m: float
     yaw_error_rad: float
     location: str
+    outside: str = ""  # in the expected nest but outside its tolerance: the limits it missed

@@ -188,6 +188,6 @@ def misplacement(destination: str, placement: PlacementCheck) -> str:
         return f"{MISPLACED}the plate is not in {destination}; it is at {placement.location}"
     return (
         f"{MISPLACED}the plate rests in {destination} but outside the nest's tolerance: "
-        f"{1000.0 * placement.position_error_m:.1f} mm from the centre, yaw "
-        f"{math.degrees(placement.yaw_error_rad):.1f} deg (a raised or tilted plate is outside too)"
+        f"{placement.outside or 'limit not reported'} ({1000.0 * placement.position_error_m:.1f} mm "
+        f"from the centre, yaw {math.degrees(placement.yaw_error_rad):.1f} deg)"
     )

@@ -186,6 +186,7 @@ class SimNode:
         response.position_error_m = float(check.position_error_m)
         response.yaw_error_rad = float(check.yaw_error_rad)
         response.location = str(check.location)
+        response.outside = str(check.outside)
         return response
 
 

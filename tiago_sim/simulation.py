@@ -62,6 +62,11 @@ DOCK_OVERTRAVEL = 0.08  # m: the reverse drive aims this far past the docked pos
 TOOL_SPEED = 0.08  # m/s along straight tool moves unless the caller asks otherwise
 STRAIGHT_STEP = 0.01  # m between IK waypoints
 MAX_WAYPOINT_JUMP = 0.25  # rad between consecutive IK waypoints
+# A delivered plate rests in its nest when it is within the nest's clearance + 1 mm per axis and
+# under these limits (the success check of every transfer).
+PLACED_HEIGHT_TOLERANCE_MM = 2.0
+PLACED_YAW_TOLERANCE_DEG = 2.0
+PLACED_TILT_TOLERANCE_DEG = 1.0
 NEST_SENSOR_RANGE = 0.02  # m: presence sensor sees a plate whose centre is this close to the site
 
 # Arms folded beside the torso (PAL's "home"), head level.
@@ -78,6 +83,7 @@ class PlacementCheck:
     position_error_m: float
     yaw_error_rad: float
     location: str
+    outside: str = ""  # in the expected nest but not in_nest: every limit it missed
 
 
 class StepLedger:
@@ -480,15 +486,21 @@ class Simulation:
         position_error = float(np.linalg.norm(offset[:2, 3]))
         yaw_error = abs(tf.wrap_angle(tf.yaw_of(offset)))
         tilt = tf.rotation_angle(np.eye(3), offset[:3, :3]) - yaw_error
-        margin = site.nest_clearance + 0.001
-        in_nest = bool(
-            abs(offset[0, 3]) <= margin
-            and abs(offset[1, 3]) <= margin
-            and abs(offset[2, 3]) < 0.002
-            and yaw_error < math.radians(2.0)
-            and abs(tilt) < math.radians(1.0)
-        )
-        return PlacementCheck(True, in_nest, position_error, float(yaw_error), location)
+        margin_mm = 1000.0 * (site.nest_clearance + 0.001)
+        x_mm, y_mm, z_mm = (1000.0 * float(v) for v in offset[:3, 3])
+        missed = [
+            f"{label} {value:.1f} {unit} (limit {limit:.1f})"
+            for label, value, unit, limit in (
+                ("off along the nest's long side by", abs(x_mm), "mm", margin_mm),
+                ("off across the nest by", abs(y_mm), "mm", margin_mm),
+                ("raised" if z_mm > 0 else "sunk", abs(z_mm), "mm", PLACED_HEIGHT_TOLERANCE_MM),
+                ("turned", math.degrees(yaw_error), "deg", PLACED_YAW_TOLERANCE_DEG),
+                ("tilted", abs(math.degrees(tilt)), "deg", PLACED_TILT_TOLERANCE_DEG),
+            )
+            if value >= limit
+        ]
+        outside = ", ".join(missed)
+        return PlacementCheck(True, not missed, position_error, float(yaw_error), location, outside)
 
     def _locate(self, labware_id: str) -> str:
         for _side, gripper in self.grippers.items():
