@@ -77,7 +77,7 @@ class Child:
 
 # Main thread only (signal handlers run there): an interrupt that arrives while a child is being
 # started is held until the child is registered, so the group's stop reaches it.
-_starting_children = 0
+_starting_child = False
 _interrupt_pending = False
 
 
@@ -85,7 +85,7 @@ def interrupt_between_starts(_signum: int, _frame: FrameType | None) -> None:
     """Signal handler raising KeyboardInterrupt, but never between starting a child (own session,
     so no terminal signal reaches it) and registering it: that left a sequencer running."""
     global _interrupt_pending
-    if _starting_children:
+    if _starting_child:
         _interrupt_pending = True
         return
     raise KeyboardInterrupt
@@ -110,8 +110,8 @@ class ProcessGroup:
             output = log_path.open("wb")
         else:
             output = output_file = tempfile.TemporaryFile(prefix=f"sila-labware-{name}-")
-        global _starting_children, _interrupt_pending
-        _starting_children += 1
+        global _starting_child, _interrupt_pending
+        _starting_child = True
         try:
             popen = subprocess.Popen(
                 argv,
@@ -124,11 +124,11 @@ class ProcessGroup:
             child = Child(name, popen, log_path, output_file)
             self.children.append(child)
         finally:
-            _starting_children -= 1
+            _starting_child = False
             if output_file is None:
                 output.close()  # the child holds its own descriptor
         logger.info("started %s (pid %d): %s", name, popen.pid, " ".join(argv))
-        if _interrupt_pending and not _starting_children:
+        if _interrupt_pending:
             _interrupt_pending = False
             raise KeyboardInterrupt
         return child

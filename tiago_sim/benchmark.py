@@ -193,25 +193,20 @@ def _marker_errors(log_path: Path, world: Any, truth: dict[str, Any], np: Any, t
     """Marker positions the robot perceived (sim_node log) against ground truth.
 
     Truth: the marker pose from the world file seen from the true base pose that the sim node
-    publishes on /ground_truth/base_pose (taken while the base stood at the station). A sighting
-    followed by "aligning at" was taken at the POI before the final approach moved the base, so
-    that truth does not apply to it; it is counted, not compared.
+    publishes on /ground_truth/base_pose (taken while the base stood at the station). The sighting
+    logged just before "aligning at" was taken at the POI before the final approach moved the
+    base, so that truth does not apply to it; it is counted, not compared.
     """
-    sightings: list[tuple[Any, Any, bool]] = []  # station, T_base_marker seen, taken before the approach
+    sightings: list[list[Any]] = []  # [station, T_base_marker seen, taken before the approach]
     for line in log_path.read_text().splitlines():
-        if "tiago_sim.base_alignment: aligning at " in line:
-            name = line.split("aligning at ", 1)[1].split(":")[0]
-            for index in range(len(sightings) - 1, -1, -1):
-                if sightings[index][0].name == name:
-                    sightings[index] = (sightings[index][0], sightings[index][1], True)
-                    break
+        if "tiago_sim.base_alignment: aligning at " in line and sightings:
+            sightings[-1][2] = True
         elif "tiago_sim.marker_motion: marker" in line:
             station = world.station(line.split(" of ", 1)[1].split()[0])
             position, quaternion = (
                 np.array([float(v) for v in part.split("]")[0].split()]) for part in line.split("[")[1:3]
             )
-            seen = tf.from_pose(position, quaternion)
-            sightings.append((station, seen, False))
+            sightings.append([station, tf.from_pose(position, quaternion), False])
     for station, seen, before_approach in sightings:
         base = truth.get(station.name)
         if base is None:

@@ -35,7 +35,6 @@ from tiago_sim.kinematics import RobotKinematics
 from tiago_sim.motion_library import HotelGrasp
 from tiago_sim.perception.aruco import detect_marker
 from tiago_sim.robot_behaviours import TOOL_SPEED_FREE, TOOL_SPEED_INTO_POCKET, RobotBehaviours
-from tiago_sim.transforms import matrix_to_quat, to_pose
 from tiago_sim.world import World
 
 log = logging.getLogger(__name__)
@@ -56,7 +55,7 @@ class MarkerSighting:
 
 
 def pose_msg(transform: np.ndarray) -> Pose:
-    position, quat = to_pose(transform)
+    position, quat = tf.to_pose(transform)
     pose = Pose()
     pose.position.x, pose.position.y, pose.position.z = (float(v) for v in position)
     pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w = (float(v) for v in quat)
@@ -102,7 +101,7 @@ class MarkerMotionBehaviour:
         log.info(
             "marker %d of %s at %s in base, quaternion %s (reprojection %.2f px)",
             station.marker_id, station_name, np.round(sighting.T_base_marker[:3, 3], 4),
-            np.round(matrix_to_quat(sighting.T_base_marker[:3, :3]), 5), observation.reprojection_error_px,
+            np.round(tf.matrix_to_quat(sighting.T_base_marker[:3, :3]), 5), observation.reprojection_error_px,
         )  # fmt: skip
         self.last_sighting = sighting
         return sighting

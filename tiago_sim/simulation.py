@@ -62,8 +62,9 @@ DOCK_OVERTRAVEL = 0.08  # m: the reverse drive aims this far past the docked pos
 TOOL_SPEED = 0.08  # m/s along straight tool moves unless the caller asks otherwise
 STRAIGHT_STEP = 0.01  # m between IK waypoints
 MAX_WAYPOINT_JUMP = 0.25  # rad between consecutive IK waypoints
-# A delivered plate rests in its nest when it is within the nest's clearance + 1 mm per axis and
-# under these limits (the success check of every transfer).
+# A delivered plate rests in its nest when it is within the nest's clearance + this per axis and
+# under the other limits (the success check of every transfer).
+PLACED_BEYOND_CLEARANCE_MM = 1.0
 PLACED_HEIGHT_TOLERANCE_MM = 2.0
 PLACED_YAW_TOLERANCE_DEG = 2.0
 PLACED_TILT_TOLERANCE_DEG = 1.0
@@ -486,7 +487,7 @@ class Simulation:
         position_error = float(np.linalg.norm(offset[:2, 3]))
         yaw_error = abs(tf.wrap_angle(tf.yaw_of(offset)))
         tilt = tf.rotation_angle(np.eye(3), offset[:3, :3]) - yaw_error
-        margin_mm = 1000.0 * (site.nest_clearance + 0.001)
+        margin_mm = 1000.0 * site.nest_clearance + PLACED_BEYOND_CLEARANCE_MM
         x_mm, y_mm, z_mm = (1000.0 * float(v) for v in offset[:3, 3])
         missed = [
             f"{label} {value:.1f} {unit} (limit {limit:.1f})"
