@@ -84,8 +84,10 @@ def test_cancel_stops_the_base_and_reports_canceled():
     try:
         sim.run(sim.undock())
         motion = sim.drive_to(3.0, -1.0, 0.0)
-        for _ in range(int(2.0 / sim.time_step)):
+        cancel_at = sim.sim_time + 2.0  # mid-drive (steps are 1/240 to 1/60 s long)
+        while sim.sim_time < cancel_at:
             sim.step()
+        assert not motion.done
         motion.cancel()
         sim.run(motion)
         assert motion.done and not motion.success and motion.error_code == "CANCELED"

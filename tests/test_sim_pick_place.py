@@ -9,11 +9,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from sim_steps import step_lengths
 
 from tiago_sim import robot_model as rm
 from tiago_sim import transforms as tf
 from tiago_sim.kinematics import top_down_grasp
-from tiago_sim.simulation import HOME_ARM, Simulation
+from tiago_sim.simulation import FREE_MOTION_STEP_RATIO, HOME_ARM, Simulation
 from tiago_sim.world import load_world
 
 ARM = "right"
@@ -108,6 +109,31 @@ def test_plate_goes_from_station_a_through_the_hotel_to_station_b():
         assert check.yaw_error_rad < np.radians(1.0)
         assert ("station_b", 1, True, PLATE) in sim.nest_occupancy()
         assert max(script.slips_m) < 0.003, script.slips_m
+    finally:
+        sim.close()
+
+
+def test_a_held_plate_takes_long_steps_in_free_space_and_short_ones_near_the_table():
+    """The long step is where the simulation wins its speed; a held plate gets it only out of reach."""
+    sim = Simulation(load_world(), seed=11)
+    script = Script(sim)
+    try:
+        script.run(sim.undock(), "undock")
+        script.drive("station_a_work")
+        T_base_site = script.site_in_base("station_a", 1)
+        script.run(sim.move_tool(ARM, script.grasp(T_base_site, APPROACH), straight_line=False), "approach")
+        script.run(sim.move_tool(ARM, script.grasp(T_base_site)), "descend")
+        script.run(sim.gripper(ARM, close=True), "close")
+        long_step = sim.time_step * FREE_MOTION_STEP_RATIO
+        lift = sim.move_tool(ARM, script.grasp(T_base_site, CARRY))
+        up = step_lengths(sim, lift)
+        assert lift.success, lift
+        assert up[:20] == [sim.time_step] * 20 and up[-1] == long_step, up
+        lower = sim.move_tool(ARM, script.grasp(T_base_site, 0.002))
+        down = step_lengths(sim, lower)
+        assert lower.success, lower
+        assert down[0] == long_step and down[-20:] == [sim.time_step] * 20, down
+        assert sim.check_placement(PLATE, "", 0).location == "gripper"
     finally:
         sim.close()
 

@@ -1,28 +1,21 @@
 """Adaptive physics step: long steps in free motion, the notes' 1/240 s wherever a plate is handled.
 
 Why a test: the long step is where the simulation wins its speed, and it must never reach the
-grasp; a plate resting in the hotel pocket rides a drive at long steps without slipping.
+grasp; a plate resting in the hotel pocket rides a drive clamped, at long steps, without slipping,
+and the clamp lets go once the base stands.
 """
 
 from __future__ import annotations
 
 import numpy as np
 import pybullet as p
+from sim_steps import step_lengths
 
 from tiago_sim import transforms as tf
 from tiago_sim.simulation import FREE_MOTION_STEP_RATIO, Simulation
 from tiago_sim.world import load_world
 
 PLATE = "plate_001"
-
-
-def _steps_until_done(sim: Simulation, motion) -> list[float]:
-    lengths = []
-    while not motion.done:
-        sim.step()
-        lengths.append(sim.last_step_s)
-        assert sim.sim_time < 120.0
-    return lengths
 
 
 def _put_plate_in_hotel(sim: Simulation, slot: int) -> None:
@@ -44,25 +37,33 @@ def test_driving_takes_long_steps_and_a_gripper_motion_short_ones():
     sim = Simulation(load_world(), seed=4)
     try:
         long_step = sim.time_step * FREE_MOTION_STEP_RATIO
-        assert set(_steps_until_done(sim, sim.undock())) == {long_step}
-        closing = _steps_until_done(sim, sim.gripper("right", close=True))
+        assert set(step_lengths(sim, sim.undock())) == {long_step}
+        closing = step_lengths(sim, sim.gripper("right", close=True))
         assert closing and set(closing) == {sim.time_step}
     finally:
         sim.close()
 
 
-def test_plate_in_the_hotel_rides_a_drive_at_long_steps_without_slipping():
+def test_plate_in_the_hotel_rides_a_drive_clamped_at_long_steps_without_slipping():
     world = load_world()
     sim = Simulation(world, seed=6)
     try:
         _put_plate_in_hotel(sim, 1)
         assert sim.hotel_occupancy()[0][1] == PLATE
         before = _plate_in_base(sim)
-        assert set(_steps_until_done(sim, sim.undock())) == {sim.time_step * FREE_MOTION_STEP_RATIO}
+        long_step = sim.time_step * FREE_MOTION_STEP_RATIO
+        assert set(step_lengths(sim, sim.undock())) == {long_step}
         lab = world.pois["lab_centre"]
-        lengths = _steps_until_done(sim, sim.drive_to(lab.x, lab.y, lab.yaw))
-        long_share = lengths.count(sim.time_step * FREE_MOTION_STEP_RATIO) / len(lengths)
-        assert long_share > 0.3, long_share  # straight stretches; turns with a plate stay short
+        drive = sim.drive_to(lab.x, lab.y, lab.yaw)
+        sim.step()
+        assert sim.hotel_clamp.closed
+        assert set(step_lengths(sim, drive)) == {long_step}  # turns too
+        while sim.hotel_clamp.closed:  # it opens once the base stands
+            sim.step()
+            assert sim.sim_time < 120.0
+        assert sim.base.stopped()
+        for _ in range(60):
+            sim.step()
         after = _plate_in_base(sim)
         assert np.linalg.norm(after[:3, 3] - before[:3, 3]) < 0.001
         assert abs(tf.wrap_angle(tf.yaw_of(tf.invert(before) @ after))) < np.radians(0.2)

@@ -142,5 +142,8 @@ class PlateFaults:
 
 def _teleport(sim: Any, body: int, position: list, quat: list, velocity: list | None = None) -> None:
     """Move a body and give it a velocity (zero unless given); physics takes over from there."""
+    for labware_id, plate in sim.scene.plates.items():
+        if plate == body:
+            sim.hotel_clamp.open(labware_id)  # a clamped plate would spring back to the tray
     p.resetBasePositionAndOrientation(body, position, quat, physicsClientId=sim.client_id)
     p.resetBaseVelocity(body, velocity or [0, 0, 0], [0, 0, 0], physicsClientId=sim.client_id)

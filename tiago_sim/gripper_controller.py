@@ -82,28 +82,8 @@ class Gripper:
 
     def attach(self, labware_id: str) -> None:
         """Fix the plate to the palm where it is now (only after a verified friction grasp)."""
-        client = self.body.client
         plate = self.plate_bodies[labware_id]
-        palm = p.getLinkState(
-            self.body.id, self.palm_link, computeForwardKinematics=True, physicsClientId=client
-        )
-        plate_pos, plate_quat = p.getBasePositionAndOrientation(plate, physicsClientId=client)
-        # constraint frames are relative to the link's centre of mass frame (world pose in state[0:2])
-        inv_pos, inv_quat = p.invertTransform(palm[0], palm[1])
-        parent_pos, parent_quat = p.multiplyTransforms(inv_pos, inv_quat, plate_pos, plate_quat)
-        self.attach_constraint = p.createConstraint(
-            self.body.id,
-            self.palm_link,
-            plate,
-            -1,
-            p.JOINT_FIXED,
-            [0, 0, 0],
-            parent_pos,
-            [0, 0, 0],
-            parentFrameOrientation=parent_quat,
-            physicsClientId=client,
-        )
-        p.changeConstraint(self.attach_constraint, maxForce=ATTACH_FORCE, physicsClientId=client)
+        self.attach_constraint = self.body.fix_to_link(self.palm_link, plate, ATTACH_FORCE)
         self.attached_id = labware_id
 
     def detach(self) -> None:

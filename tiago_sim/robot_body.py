@@ -191,6 +191,36 @@ class RobotBody:
         state = p.getLinkState(self.id, index, computeForwardKinematics=True, physicsClientId=self.client)
         return tf.from_pose(state[4], state[5]) @ offset
 
+    def fix_to_link(self, link: int, body: int, max_force: float) -> int:
+        """A fixed constraint holding ``body`` to ``link`` (-1: the base) where it is now, no jump.
+
+        Constraint frames are relative to the link's centre of mass frame, which getLinkState's
+        [0:2] and getBasePositionAndOrientation give in world.
+        """
+        client = self.client
+        if link < 0:
+            link_position, link_quat = p.getBasePositionAndOrientation(self.id, physicsClientId=client)
+        else:
+            state = p.getLinkState(self.id, link, computeForwardKinematics=True, physicsClientId=client)
+            link_position, link_quat = state[0], state[1]
+        body_position, body_quat = p.getBasePositionAndOrientation(body, physicsClientId=client)
+        inv_position, inv_quat = p.invertTransform(link_position, link_quat)
+        parent_position, parent_quat = p.multiplyTransforms(inv_position, inv_quat, body_position, body_quat)
+        constraint = p.createConstraint(
+            self.id,
+            link,
+            body,
+            -1,
+            p.JOINT_FIXED,
+            [0, 0, 0],
+            parent_position,
+            [0, 0, 0],
+            parentFrameOrientation=parent_quat,
+            physicsClientId=client,
+        )
+        p.changeConstraint(constraint, maxForce=max_force, physicsClientId=client)
+        return constraint
+
     def frame_on_link(self, frame: str) -> tuple[int, np.ndarray]:
         """(PyBullet link index, T_link_frame) of any URDF link, merged or not."""
         if frame in self.link_index:

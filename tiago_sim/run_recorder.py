@@ -63,7 +63,7 @@ class RunRecorder:
             self.save_overview()
 
     def save_overview(self) -> Path:
-        rgb, _ = render_rgbd(self.sim.client_id, self.T_world_overview, OVERVIEW_INTRINSICS)
+        rgb, _ = render_rgbd(self.sim.client_id, self.T_world_overview, OVERVIEW_INTRINSICS, shadow=True)
         self.overview_count += 1
         label = f"t = {self.sim.sim_time:5.1f} s (simulated)"
         canvas = np.ascontiguousarray(rgb.copy())

@@ -23,6 +23,7 @@ from tiago_sim import transforms as tf
 from tiago_sim.arm_controller import JointTrajectoryMotion
 from tiago_sim.base_controller import DiffDriveBase, DriveMotion
 from tiago_sim.gripper_controller import Gripper, GripperMotion
+from tiago_sim.hotel_clamp import HotelClamp
 from tiago_sim.kinematics import RobotKinematics
 from tiago_sim.motion import BUSY, CompletedMotion, FailedMotion, Motion, SequenceMotion
 from tiago_sim.perception.camera import CameraIntrinsics, render_rgbd
@@ -32,30 +33,36 @@ from tiago_sim.world import World
 
 log = logging.getLogger(__name__)
 
-# Solver iterations by situation: the notes' 150 while fingers close or open on a plate; 30 while a
-# plate is attached to a gripper or rides in the hotel; 20 otherwise (joint tracking error stays under
-# 1 mrad). Carrying at 30 instead of 50 cut the CPU of a scripted A -> hotel -> B run by 15 to 30 %
-# (carrying steps 0.43 instead of 0.74 ms); slips in the gripper stayed under 1.2 mm (50: 0.1 mm),
-# placement error 0.2 to 1.4 mm either way.
+# Solver iterations by situation: the notes' 150 while fingers close or open on a plate; 20 otherwise
+# (joint tracking error stays under 1 mrad). A plate held by a gripper or riding the hotel is fixed
+# by a constraint (the travel attach, the hotel clamp), so it needs no more: at 20 instead of 30
+# the physics of a benchmark transfer took 3.8 instead of 4.8 s CPU and the placement error stayed
+# at 1.0 to 1.6 mm (seeds 1 to 3).
 SOLVER_ITERATIONS_GRASPING = 150
-SOLVER_ITERATIONS_CARRYING = 30
 SOLVER_ITERATIONS = 20
-# Physics step: the notes' 1/240 s whenever a gripper moves, holds a plate, or any moving link (arm,
-# torso, head) comes within PLATE_NEAR_RANGE of a plate (grasp, carry, place, release); 1/120 s
-# otherwise (driving, free arm moves, a plate resting in the hotel pocket while the base drives
-# straight), where only joint tracking, the kinematic base and resting contact are simulated. Half the
-# steps in those phases is the largest saving of wall time per simulated second. While the base turns
-# with a plate in the hotel the short step stays: the resting contact drifts outwards per step on the
-# curved path (measured over a 1.5 rad turn: 0.63 mm at 1/240 s, 1.25 mm at 1/120 s; none straight).
-FREE_MOTION_STEP_RATIO = 2
-# Error reduction of joint constraints (the base carrier) per step: Bullet's 0.2 at 1/240 s; 0.3 at
-# 1/120 s keeps the base's lag behind its commanded pose at the same ~17 ms (measured: 5.3 vs 8.8 mm
-# at 0.27 and 0.53 m/s), so the base moves and stops alike at either step.
+# Physics step: the notes' 1/240 s whenever a gripper moves, or a moving link (arm, torso, head)
+# comes within PLATE_NEAR_RANGE of a plate resting anywhere, or a held plate comes within reach of
+# anything but its own arm (grasp, place, release, into and out of the hotel); FREE_MOTION_STEP_RATIO
+# times that otherwise (driving, free arm moves, carrying through free space), where only joint
+# tracking, the kinematic base and constrained plates are simulated. The long step is the largest
+# saving of wall time per simulated second: 1/60 s halved the steps of the free phases against
+# 1/120 s (a benchmark transfer: 2230 instead of 4260 steps, 0.6 s CPU less) with the marker-guided
+# alignment, the placement and the docking as accurate as before. A plate resting in the hotel by
+# contact alone used to keep the steps short while the base turned (it crept outwards per step on
+# the curved path); the hotel clamp now holds it while the base moves.
+FREE_MOTION_STEP_RATIO = 4
+# Error reduction of joint constraints (the base carrier) per step: Bullet's 0.2 at 1/240 s, 0.5 at
+# the long step, so that the base lags its commanded pose by the same 17 ms at either step (about
+# step * (1 - erp) / erp; measured at 0.27 and 0.53 m/s: 16.7 ms at 1/240 s and 0.2, 20.4 ms at
+# 1/60 s and 0.45, 11.1 ms at 1/60 s and 0.6).
 CONSTRAINT_ERP = 0.2
-FREE_MOTION_CONSTRAINT_ERP = 0.3
+FREE_MOTION_CONSTRAINT_ERP = 0.5
 PLATE_NEAR_RANGE = 0.15  # m between a moving robot link and a plate: a finger contact may start soon
-LOADED_TURN_RATE = 0.05  # rad/s: above it, with a plate in the hotel, steps stay short
 STEP_REVIEW_PERIOD = 0.05  # s of sim time between proximity checks (tool <= 1.5 m/s: 7.5 cm)
+# A held plate is within reach of something when it is closer than this margin plus twice the
+# distance it travels in a review period at its current speed (it cannot get there unnoticed).
+HELD_PLATE_MARGIN = 0.03  # m
+LOADED_TURN_RATE = 0.05  # rad/s: above it, with an unclamped plate in the hotel, steps stay short
 DOCK_SENSOR_RANGE = 0.004  # m: the charging contacts close within this distance
 DOCK_SPEED = 0.05  # m/s backing onto the dock: stops within 3 mm once the contacts close
 DOCK_OVERTRAVEL = 0.08  # m: the reverse drive aims this far past the docked pose, contact ends it
@@ -146,6 +153,16 @@ class Simulation:
         dock = world.dock_pose
         self.base = DiffDriveBase(self.robot, dock.x, dock.y, dock.yaw, odometry_noise, self.rng)
         self.grippers = {side: Gripper(self.robot, side, self.scene.plates) for side in rm.ARM_SIDES}
+        self.hotel_clamp = HotelClamp(self.robot, self.scene.plates)
+        self._clamped_for_drive = False
+        self._own_arm_links = {
+            side: {
+                index
+                for name, index in self.robot.link_index.items()
+                if name.startswith((f"arm_{side}_", f"gripper_{side}_"))
+            }
+            for side in rm.ARM_SIDES
+        }
         self.kinematics = RobotKinematics()
         self.motions: list[Motion] = []
         self._iterations = SOLVER_ITERATIONS
@@ -153,7 +170,6 @@ class Simulation:
         self.last_step_s = time_step  # length of the latest physics step (s)
         self.step_ledger = StepLedger()
         self._reviewed_at = -1.0
-        self._carrying = False
         self._plate_within_range = True
         self._turning_loaded = False
         for _ in range(int(0.5 / time_step)):  # let plates settle in their nests
@@ -188,6 +204,7 @@ class Simulation:
             base_driven = base_driven or ("base" in motion.resources and not motion.done)
         if not base_driven:
             self.base.command(0.0, 0.0)  # no drive running: the base brakes and stands
+        self._clamp_while_driving(base_driven)
         self.base.update(dt)
         started = time.thread_time()
         p.stepSimulation(physicsClientId=self.client_id)
@@ -198,28 +215,29 @@ class Simulation:
         if any(m.done for m in motions):
             self.motions = [m for m in motions if not m.done]
 
+    def _clamp_while_driving(self, base_driven: bool) -> None:
+        """The hotel clamp closes when a base motion starts and opens once the base stands."""
+        if base_driven and not self._clamped_for_drive:
+            self.hotel_clamp.close(held=self._held_plates())
+            self._clamped_for_drive = True
+        elif not base_driven and self._clamped_for_drive and self.base.stopped():
+            self.hotel_clamp.open()
+            self._clamped_for_drive = False
+
+    def _held_plates(self) -> set[str]:
+        return {g.attached_id for g in self.grippers.values() if g.attached_id}
+
     def _choose_step(self) -> float:
         """Solver iterations and step length for the coming step (see the constants above)."""
         grasping = any(isinstance(m, GripperMotion) for m in self.motions)
         if not grasping and self.sim_time - self._reviewed_at >= STEP_REVIEW_PERIOD - 1e-9:
             self._reviewed_at = self.sim_time
-            attached = any(g.attached_id for g in self.grippers.values())
-            self._carrying = attached or bool(
-                p.getContactPoints(bodyA=self.robot.id, linkIndexA=-1, physicsClientId=self.client_id)
-            )
-            self._plate_within_range = attached or any(
-                point[3] != -1  # link A: any link but the base (its hotel pocket carries plates)
-                for plate in self.scene.plates.values()
-                for point in p.getClosestPoints(
-                    self.robot.id, plate, PLATE_NEAR_RANGE, physicsClientId=self.client_id
-                )
-            )
+            self._plate_within_range = self._robot_near_resting_plate() or self._held_plate_near_anything()
             turn_rate = max(abs(self.base.w), abs(self.base.w_cmd))
-            self._turning_loaded = self._carrying and turn_rate > LOADED_TURN_RATE
-        if grasping:
-            iterations = SOLVER_ITERATIONS_GRASPING
-        else:
-            iterations = SOLVER_ITERATIONS_CARRYING if self._carrying else SOLVER_ITERATIONS
+            self._turning_loaded = turn_rate > LOADED_TURN_RATE and bool(
+                self.hotel_clamp.resting_on_tray(self._held_plates() | set(self.hotel_clamp.constraints))
+            )
+        iterations = SOLVER_ITERATIONS_GRASPING if grasping else SOLVER_ITERATIONS
         if iterations != self._iterations:
             self._iterations = iterations
             p.setPhysicsEngineParameter(numSolverIterations=iterations, physicsClientId=self.client_id)
@@ -230,6 +248,37 @@ class Simulation:
             erp = CONSTRAINT_ERP if step == self.time_step else FREE_MOTION_CONSTRAINT_ERP
             p.setPhysicsEngineParameter(fixedTimeStep=step, erp=erp, physicsClientId=self.client_id)
         return step
+
+    def _robot_near_resting_plate(self) -> bool:
+        """A robot link other than the base (its hotel tray carries plates) near a plate no gripper holds."""
+        held = self._held_plates()
+        return any(
+            point[3] != -1
+            for labware_id, plate in self.scene.plates.items()
+            if labware_id not in held
+            for point in p.getClosestPoints(
+                self.robot.id, plate, PLATE_NEAR_RANGE, physicsClientId=self.client_id
+            )
+        )
+
+    def _held_plate_near_anything(self) -> bool:
+        """A held plate within reach of a body, or of a robot link other than its own arm's."""
+        c = self.client_id
+        for side, gripper in self.grippers.items():
+            if not gripper.attached_id:
+                continue
+            plate = self.scene.plates[gripper.attached_id]
+            speed = float(np.linalg.norm(p.getBaseVelocity(plate, physicsClientId=c)[0]))
+            reach = HELD_PLATE_MARGIN + 2.0 * speed * STEP_REVIEW_PERIOD
+            own_links = self._own_arm_links[side]
+            for index in range(p.getNumBodies(physicsClientId=c)):
+                other = p.getBodyUniqueId(index, physicsClientId=c)
+                if other == plate:
+                    continue
+                for point in p.getClosestPoints(plate, other, reach, physicsClientId=c):
+                    if other != self.robot.id or point[4] not in own_links:
+                        return True
+        return False
 
     def busy(self) -> bool:
         return any(not m.done for m in self.motions)

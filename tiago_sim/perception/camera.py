@@ -91,12 +91,16 @@ def render_rgbd(
     intrinsics: CameraIntrinsics,
     supersample: int = 1,
     renderer: int = p.ER_TINY_RENDERER,
+    shadow: bool = False,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Render (rgb uint8 HxWx3, depth_m float32 HxW) seen from the optical frame pose.
 
     With ``supersample`` > 1 the scene is rendered that many times larger and averaged down,
     which smooths edges and gives sub-pixel accurate marker corners (at about that factor
     squared in render time). Pixels that hit nothing read ``intrinsics.far``.
+
+    ``shadow`` casts shadows. TinyRenderer's default casts them, which doubles a head-camera frame
+    (station view: 222 vs 117 ms); they only change pixels by a few grey levels.
     """
     if supersample < 1:
         raise ValueError(f"supersample must be >= 1, got {supersample}")
@@ -111,6 +115,7 @@ def render_rgbd(
         projectionMatrix=render_intrinsics.gl_projection(sample_offset).T.flatten().tolist(),
         renderer=renderer,
         flags=p.ER_NO_SEGMENTATION_MASK,
+        shadow=int(shadow),
         physicsClientId=client_id,
     )
     shape = (render_intrinsics.height, render_intrinsics.width)
