@@ -131,6 +131,11 @@ class SimThread:
         self._ready.set_result(True)
         wall_start, sim_start = time.monotonic(), sim.sim_time
         paced_factor: float | None = None
+
+        def ahead_of_wall_s(factor: float) -> float:
+            """How far the sim clock runs ahead of the wall clock at this pace (negative: behind)."""
+            return (sim.sim_time - sim_start) / factor - (time.monotonic() - wall_start)
+
         try:
             while not self._stop.is_set():
                 cpu_before = time.thread_time()
@@ -151,17 +156,25 @@ class SimThread:
                     self.sim_time = sim.sim_time
                     factor = self.realtime_factor_cap
                 else:
+                    factor = self.idle_realtime_factor
+                    if factor == paced_factor and factor is not None and factor > 0:
+                        ahead_s = ahead_of_wall_s(factor)
+                        if ahead_s > 0:
+                            # Woken for a job while the idle clock is ahead of the wall: no step, or
+                            # every job would advance the idle robot's clock by one physics step
+                            # (up to 1/60 s) on top of the wall time it took (about 1 s a transfer).
+                            self._wake.wait(min(ahead_s, 0.05))
+                            continue
                     sim.step()
                     self.steps += 1
                     self.sim_time = sim.sim_time
-                    factor = self.idle_realtime_factor
                 if factor is None or factor <= 0 or factor != paced_factor:
                     # Unpaced, or the pace changed: measure from here.
                     wall_start, sim_start = time.monotonic(), sim.sim_time
                     paced_factor = factor
                     continue
                 # Sleep until wall time catches up with sim time at the chosen factor.
-                ahead_s = (sim.sim_time - sim_start) / factor - (time.monotonic() - wall_start)
+                ahead_s = ahead_of_wall_s(factor)
                 if ahead_s > 0:
                     self._wake.wait(min(ahead_s, 0.05))
                 elif ahead_s < -0.5:  # fell behind (busy phases): do not try to catch up later
