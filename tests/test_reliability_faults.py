@@ -16,11 +16,13 @@ from collections.abc import Iterator
 import pytest
 from sila2.framework import DefinedExecutionError
 from sila_stack import start_stack
-from transfer_steps import Cell, finish
+from transfer_steps import Cell, finish, wait_for_progress
 
 from sila_labware.deployment import Deployment
 
 PLATE = "plate_001"
+KILL_AT_PROGRESS = 0.35
+"""GetLabware past its final approach: the arm is on its way to the plate."""
 A1, B1 = ("station_a", 1), ("station_b", 1)
 
 
@@ -39,8 +41,7 @@ def kill_during_get_labware(cell: Cell, child_name: str, source: tuple[str, int]
     subscription.add_callback(states.append)
     cell.prepare_pick(source, PLATE)
     get = cell.manipulator.GetLabware(HandoverPosition=source, IntermediateActions=[])
-    time.sleep(2.0)  # the arm is reaching for the plate
-    assert not get.done
+    wait_for_progress(get, KILL_AT_PROGRESS)
     deployment: Deployment = cell.deployment
     child = next(c for c in deployment.children.children if c.name == child_name)
     os.killpg(child.popen.pid, signal.SIGKILL)

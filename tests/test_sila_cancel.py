@@ -21,7 +21,7 @@ import pytest
 from sila2.framework import DefinedExecutionError
 from sila_stack import start_stack
 from sim_parameters import set_node_parameter
-from transfer_steps import Cell, finish
+from transfer_steps import Cell, finish, wait_for_progress
 
 PLATE = "plate_001"
 A1, B1 = ("station_a", 1), ("station_b", 1)
@@ -54,12 +54,7 @@ def reported_location(cell: Cell) -> str:
 
 def cancel_mid_way(cell: Cell, get: Any) -> float:
     """Wait until GetLabware is under way, then StopMotion; returns when StopMotion was called."""
-    deadline = time.monotonic() + 60.0
-    while (get.progress or 0.0) < CANCEL_AT_PROGRESS:
-        assert not get.done, "GetLabware ended before it could be cancelled"
-        assert time.monotonic() < deadline, f"GetLabware made no progress: {get.progress}"
-        time.sleep(0.02)
-    assert not get.done
+    wait_for_progress(get, CANCEL_AT_PROGRESS)
     cell.robot.MobileRobotController.StopMotion()
     return time.monotonic()
 

@@ -27,6 +27,20 @@ def finish(instance: Any, timeout_s: float = 300.0) -> Any:
     return instance.get_responses()
 
 
+def wait_for_progress(instance: Any, at: float, timeout_s: float = 60.0) -> None:
+    """Return once a running observable command reports ``at`` progress; it must not end before.
+
+    Why: tests that act mid-command (cancel, kill the robot side) must not guess how long a
+    command takes; the robot gets faster, a sleep then lands after the end.
+    """
+    deadline = time.monotonic() + timeout_s
+    while (instance.progress or 0.0) < at:
+        assert not instance.done, f"the command ended before {at:.0%} progress"
+        assert time.monotonic() < deadline, f"no {at:.0%} progress in {timeout_s:.0f} s: {instance.progress}"
+        time.sleep(0.02)
+    assert not instance.done
+
+
 def together(*starts: Callable[[], Any], timeout_s: float = 300.0) -> None:
     """Start observable commands at once, then wait for all; the first SiLA error propagates."""
     instances = [start() for start in starts]
