@@ -7,7 +7,10 @@ The judge is the plate's physical pose, read from PyBullet.
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
+import pybullet as p
 import pytest
 from sim_steps import step_lengths
 
@@ -165,6 +168,48 @@ def test_nest_lead_ins_guide_a_plate_released_off_centre():
         check = sim.check_placement(PLATE, "station_a", 2)
         assert check.in_nest, check
         assert check.position_error_m < 0.0025
+    finally:
+        sim.close()
+
+
+def _rest_plate_on_pocket_edge(sim: Simulation, side: int, outwards: float, yaw: float) -> None:
+    """Set PLATE into station_a nest 2 tilted across the nest, one long bottom edge 1.5 mm up.
+
+    The raised edge is ``outwards`` beyond the pocket edge on the ``side`` (+1 or -1) long side:
+    where a plate sliding down a lead-in arrives, and where the former 1.5 mm bracket wall left
+    campaign plates resting 1 deg tilted.
+    """
+    site = sim.world.station("station_a")
+    plate = sim.world.labware_types["sbs_microplate_96"]
+    raised = 0.0015
+    tilt = side * np.arcsin(raised / plate.width)
+    edge_y = side * (plate.width / 2 + site.nest_clearance + outwards)
+    T_site_bottom = tf.from_xyz_rpy(
+        (0.0, edge_y - side * plate.width / 2 * np.cos(tilt), raised / 2 + 0.0002), (tilt, 0.0, yaw)
+    )
+    T_world_centre = site.T_world_site(2) @ T_site_bottom @ tf.make_transform((0, 0, plate.height / 2))
+    position, quat = tf.to_pose(T_world_centre)
+    body = sim.scene.plates[PLATE]
+    p.resetBasePositionAndOrientation(body, position.tolist(), quat.tolist(), physicsClientId=sim.client_id)
+    p.resetBaseVelocity(body, [0, 0, 0], [0, 0, 0], physicsClientId=sim.client_id)
+
+
+def test_a_plate_arriving_at_the_pocket_edge_settles_flat_in_the_nest():
+    """No ledge at the foot of a lead-in: the plate's bottom must not come to rest on a bracket."""
+    sim = Simulation(load_world(), seed=3)
+    try:
+        refused = []
+        for side in (1, -1):
+            for outwards_mm, yaw_deg in itertools.product(np.arange(-0.4, 1.65, 0.1), (0.0, 0.3)):
+                _rest_plate_on_pocket_edge(sim, side, outwards_mm / 1000, np.radians(yaw_deg))
+                settle_until = sim.sim_time + 2.0
+                while sim.sim_time < settle_until:
+                    sim.step()
+                check = sim.check_placement(PLATE, "station_a", 2)
+                if not check.in_nest:
+                    where = f"side {side:+d}, {outwards_mm:.1f} mm out, yaw {yaw_deg} deg"
+                    refused.append(f"{where}: {check.outside}")
+        assert not refused, refused
     finally:
         sim.close()
 

@@ -26,8 +26,8 @@ log = logging.getLogger(__name__)
 
 PLATE_FRICTION = 1.0
 PLATE_SPINNING_FRICTION = 0.02
-NEST_WALL_HEIGHT = 0.0015  # vertical part of a bracket at the pocket edge; the lead-in chamfer sits on top
-NEST_LEAD_IN = 0.006  # per side, 45 deg: the opening is this much wider than the pocket on each side
+NEST_LEAD_IN = 0.006  # per side, 45 deg from the bench top: the opening is this much wider than the pocket
+NEST_RAMP_FOOT = 0.001  # the ramp runs on this far below the bench top: no edge is left at its foot
 NEST_LEG_LENGTH = 0.015  # bracket legs run this far in from each corner
 NEST_FRICTION = 0.15  # polished lead-ins: with the plate's 1.0, the pair's friction is 0.15
 TABLE_FRICTION = 0.3  # laminate bench top: plate on table 0.3
@@ -59,35 +59,33 @@ def _static_box(client: int, size, T_world_box: np.ndarray, rgba, collide: bool 
 
 
 def nest_boxes(length: float, width: float) -> list[tuple[tuple, tuple, tuple]]:
-    """Boxes (size, centre, quaternion) of a nest: four corner L-brackets with 45 deg lead-ins.
+    """Boxes (size, centre, quaternion) of a nest: four corner L-brackets of 45 deg lead-in ramps.
 
-    Each bracket leg is a wall ``NEST_WALL_HEIGHT`` high at the pocket edge with a chamfer plate
-    on top that widens the opening by ``NEST_LEAD_IN`` per side, so a plate released up to
-    clearance + lead-in off centre slides into the pocket (low-friction bracket material).
+    Each bracket leg is a ramp rising from the pocket edge on the bench top to ``NEST_LEAD_IN``
+    outside it, so a plate released up to clearance + lead-in off centre slides into the pocket
+    (low-friction bracket material). The ramp starts at the bench top, with no vertical wall under
+    it: a wall's top corner is a ledge on which a plate's bottom rests 1 deg tilted, held by the
+    bench's friction under its other edge (campaigns 6000 and 7000 lost 1 to 1.5 % of transfers so).
     """
     boxes = []
-    wall, leg, lead, thick, h = 0.006, NEST_LEG_LENGTH, NEST_LEAD_IN, 0.003, NEST_WALL_HEIGHT
-    slope = lead * math.sqrt(2.0)
-    flat = (0.0, 0.0, 0.0, 1.0)
-    offset = thick / 2 / math.sqrt(2.0)
+    overlap, leg, lead, foot, thick = 0.006, NEST_LEG_LENGTH, NEST_LEAD_IN, NEST_RAMP_FOOT, 0.004
+    slope = (lead + foot) * math.sqrt(2.0)
+    inset = thick / 2 / math.sqrt(2.0)  # from the ramp surface to the box's mid-plane, along x (or y) and z
+    mid = (lead - foot) / 2  # the middle of the ramp surface, outwards of the pocket edge and above the bench
     for cx in (-1, 1):
         for cy in (-1, 1):
-            # leg across the short end (wall normal along x), spanning `leg` in from the corner
-            along_y = cy * (width / 2 - leg / 2 + wall / 2)
-            boxes.append(((wall, leg + wall, h), (cx * (length / 2 + wall / 2), along_y, h / 2), flat))
-            chamfer_x = cx * (length / 2 + lead / 2) + cx * offset
+            # leg across the short end (ramp rising along x), spanning `leg` in from the corner
+            along_y = cy * (width / 2 - leg / 2 + overlap / 2)
             quat_x = tf.matrix_to_quat(
                 tf.rpy_to_matrix(0.0, -math.pi / 4 if cx > 0 else -3 * math.pi / 4, 0.0)
             )
-            boxes.append(
-                ((slope, leg + wall, thick), (chamfer_x, along_y, h + lead / 2 - offset), tuple(quat_x))
-            )
-            # leg along the long side (wall normal along y)
+            centre_x = (cx * (length / 2 + mid + inset), along_y, mid - inset)
+            boxes.append(((slope, leg + overlap, thick), centre_x, tuple(quat_x)))
+            # leg along the long side (ramp rising along y)
             along_x = cx * (length / 2 - leg / 2)
-            boxes.append(((leg, wall, h), (along_x, cy * (width / 2 + wall / 2), h / 2), flat))
-            chamfer_y = cy * (width / 2 + lead / 2) + cy * offset
             quat_y = tf.matrix_to_quat(tf.rpy_to_matrix(math.pi / 4 if cy > 0 else 3 * math.pi / 4, 0.0, 0.0))
-            boxes.append(((leg, slope, thick), (along_x, chamfer_y, h + lead / 2 - offset), tuple(quat_y)))
+            centre_y = (along_x, cy * (width / 2 + mid + inset), mid - inset)
+            boxes.append(((leg, slope, thick), centre_y, tuple(quat_y)))
     return boxes
 
 
