@@ -28,6 +28,7 @@ from ros_bridge.workcell import WorkcellDescription
 from sila_labware.processes import ProcessGroup, ros_environment
 from sila_labware.robot_controller import RobotController
 from sila_labware.robot_server.server import Server as RobotServer
+from sila_labware.serving import start_sila_server
 from sila_labware.station_controller import StationController
 from sila_labware.station_server.server import Server as StationServer
 from sila_labware.supervisor import RobotSideSupervisor
@@ -154,20 +155,9 @@ class Deployment:
         authority = None if self.options.insecure else CertificateAuthority()
         for offset, (server, role, station_name) in enumerate(planned):
             port = self.options.port_base + offset
-            if authority is None:
-                server.start_insecure(self.options.host, port, enable_discovery=self.options.discovery)
-            else:
-                credentials = authority.issue_server_credentials(
-                    server.server_uuid, server.server_name, self.options.host
-                )
-                server.start(
-                    self.options.host,
-                    port,
-                    private_key=credentials.private_key_pem,
-                    cert_chain=credentials.certificate_pem,
-                    enable_discovery=self.options.discovery,
-                    ca_for_discovery=authority.certificate_pem,
-                )
+            start_sila_server(
+                server, self.options.host, port, authority=authority, discovery=self.options.discovery
+            )
             self.servers.append(
                 ServedServer(server.server_name, role, station_name, self.options.host, port, server)
             )

@@ -50,6 +50,7 @@ from sila_labware.discovery_timing import time_serve_until_discoverable
 from sila_labware.processes import ros_environment
 from sila_labware.robot_controller import RobotController
 from sila_labware.robot_server.server import Server as RobotServer
+from sila_labware.serving import start_sila_server
 
 logger = logging.getLogger(__name__)
 
@@ -212,7 +213,7 @@ def run_latency_bench(
         robot = RobotController(link, link.describe_workcell(timeout_s=10.0))
         rclpy_accepts, rclpy_feedbacks = measure_rclpy(runtime, peer, calls)
         server = RobotServer(robot)
-        server.start_insecure("127.0.0.1", port_base, enable_discovery=False)
+        start_sila_server(server, "127.0.0.1", port_base, authority=None, discovery=False)
         sila_accepts, sila_feedbacks = asyncio.run(measure_sila(port_base, peer, calls))
     finally:
         if server is not None:

@@ -21,6 +21,7 @@ from sila2.server import SilaServer
 from ros_bridge.robot_link import RobotLink
 from ros_bridge.runtime import RosRuntime
 from ros_bridge.workcell import WorkcellDescription
+from sila_labware.serving import start_sila_server
 from sila_labware.tls import CertificateAuthority
 
 logger = logging.getLogger(__name__)
@@ -59,20 +60,9 @@ def run_standalone(
         server = build_server(link, link.describe_workcell(), args)
         if args.insecure:
             logger.warning("serving WITHOUT encryption (--insecure): for tests only")
-            server.start_insecure(args.host, args.port, enable_discovery=not args.no_discovery)
-        else:
-            authority = CertificateAuthority()
-            credentials = authority.issue_server_credentials(
-                server.server_uuid, server.server_name, args.host
-            )
-            server.start(
-                args.host,
-                args.port,
-                private_key=credentials.private_key_pem,
-                cert_chain=credentials.certificate_pem,
-                enable_discovery=not args.no_discovery,
-                ca_for_discovery=authority.certificate_pem,
-            )
+        authority = None if args.insecure else CertificateAuthority()
+        start_sila_server(server, args.host, args.port, authority=authority, discovery=not args.no_discovery)
+        if authority is not None:
             authority.write_certificate(args.ca_file)
         sys.stdout.write(f"{server.server_name} at {args.host}:{args.port}\n")
         sys.stdout.flush()

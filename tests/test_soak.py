@@ -13,7 +13,6 @@ from __future__ import annotations
 import json
 import os
 import re
-import socket
 import subprocess
 import sys
 import time
@@ -25,13 +24,14 @@ from action_msgs.msg import GoalStatus, GoalStatusArray
 from rclpy.action import get_action_names_and_types
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sila2.client import SilaClient
+from sila_stack import free_port_base
 from transfer_steps import Cell
 
 from ros_bridge.runtime import RosRuntime
 
 CLI = [sys.executable, "-m", "sila_labware.cli"]
 TRANSFERS = int(os.environ.get("SOAK_TRANSFERS", "50"))
-PORT_RANGE = range(51600, 51700)
+PORT_BASES = range(51600, 51697)  # a block of 4 ports within 51600..51699
 PLATE = "plate_001"
 A, B = ("station_a", 1), ("station_b", 1)
 BRIDGE_NODE = "sila_labware_bridge"
@@ -70,24 +70,6 @@ def sample(pid: int) -> ProcessSample:
         line.split(":", 1) for line in Path(f"/proc/{pid}/status").read_text().splitlines() if ":" in line
     )
     return ProcessSample(int(fields["VmRSS"].split()[0]), int(fields["Threads"]))
-
-
-def free_port_base_in(ports: range, count: int) -> int:
-    """The first base in `ports` with `count` consecutive ports free on 127.0.0.1."""
-    for base in range(ports.start, ports.stop - count):
-        held: list[socket.socket] = []
-        try:
-            for port in range(base, base + count):
-                probe = socket.socket()
-                held.append(probe)
-                probe.bind(("127.0.0.1", port))
-            return base
-        except OSError:
-            continue
-        finally:
-            for probe in held:
-                probe.close()
-    raise RuntimeError(f"no {count} free ports in {ports.start}..{ports.stop - 1}")
 
 
 class ServedCell(Cell):
@@ -159,7 +141,7 @@ def unfinished_goals(runtime: RosRuntime, timeout_s: float = 5.0) -> dict[str, i
 @pytest.mark.soak
 @pytest.mark.timeout(7200)
 def test_many_transfers_in_one_serve_process_leak_nothing(tmp_path: Path) -> None:
-    port_base = free_port_base_in(PORT_RANGE, 4)
+    port_base = free_port_base(4, PORT_BASES)
     stdout_path, stderr_path = tmp_path / "serve.out", tmp_path / "serve.err"
     with stdout_path.open("w") as stdout, stderr_path.open("w") as stderr:
         serve = subprocess.Popen(
