@@ -9,6 +9,7 @@ to use from any thread as long as one ``RobotKinematics`` is not shared between 
 from __future__ import annotations
 
 import logging
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -129,7 +130,10 @@ class RobotKinematics:
     def _solve(
         self, q: np.ndarray, indices: np.ndarray, frame_id: int, target: pin.SE3, max_iterations: int
     ) -> tuple[np.ndarray, float, float]:
+        # Small arrays: numpy's per-call overhead, not arithmetic, sets the pace here, so the loop
+        # avoids np.linalg.norm and np.clip and indexes the joint limits once.
         eye = np.eye(6)
+        lower, upper = self.lower[indices], self.upper[indices]
         pos_err = rot_err = float("inf")
         best_err, best_at = float("inf"), 0
         for iteration in range(max_iterations):
@@ -137,8 +141,9 @@ class RobotKinematics:
             pin.updateFramePlacement(self.model, self.data, frame_id)
             current = self.data.oMf[frame_id]
             error = pin.log6(current.actInv(target)).vector
-            pos_err = float(np.linalg.norm(target.translation - current.translation))
-            rot_err = float(np.linalg.norm(error[3:]))
+            offset = target.translation - current.translation
+            pos_err = math.sqrt(offset @ offset)
+            rot_err = math.sqrt(error[3:] @ error[3:])
             if pos_err <= IK_POSITION_TOLERANCE * 0.2 and rot_err <= IK_ORIENTATION_TOLERANCE * 0.2:
                 break
             # Stalled (pinned at joint limits, or a local minimum): further iterations change nothing,
@@ -149,7 +154,7 @@ class RobotKinematics:
                 break
             jacobian = pin.computeFrameJacobian(self.model, self.data, q, frame_id, pin.LOCAL)[:, indices]
             step = jacobian.T @ np.linalg.solve(jacobian @ jacobian.T + IK_DAMPING * eye, error)
-            q[indices] = np.clip(q[indices] + step, self.lower[indices], self.upper[indices])
+            q[indices] = np.minimum(np.maximum(q[indices] + step, lower), upper)
         return q, pos_err, rot_err
 
 

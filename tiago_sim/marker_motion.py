@@ -12,8 +12,9 @@ Steps: take an image (sim thread) -> detect the marker (this thread) -> T_base_m
 T_base_optical @ T_optical_marker -> the nest frame from the world's site_in_marker, sub-position
 spacing and approach height -> the grasp pose in that frame (fingers down, closing across the
 plate's short side; the flipped twin if IK prefers it) -> Simulation.move_tool. A sighting is
-reused while the base has not moved and no keyframe motion ran since, because the arm above the
-nest hides the marker from the head. Lives on: an rclpy executor thread (one goal at a time).
+reused while the base has not moved: the marker is fixed to its station, so its pose in
+base_footprint holds whatever arms, torso and head do since (and the arm above the nest hides the
+marker from the head). Lives on: an rclpy executor thread (one goal at a time).
 """
 
 from __future__ import annotations
@@ -72,10 +73,6 @@ class MarkerMotionBehaviour:
         self.kinematics = RobotKinematics()
         self._lock = threading.Lock()
         self.last_sighting: MarkerSighting | None = None
-
-    def forget(self) -> None:
-        """Drop the cached sighting (the head or base is about to move)."""
-        self.last_sighting = None
 
     def look(self, run: ActionRun, station_name: str) -> MarkerSighting:
         """Image + joints at one instant, marker detection, marker pose in base_footprint."""

@@ -56,7 +56,6 @@ class RobotBehaviours:
         self.hotel_slots = hotel_slots
         self.motions = motions
         self.speed_scale = speed_scale
-        self.on_keyframe_motion: Callable[[], None] = lambda: None  # e.g. forget marker sightings
         self._kinematics = RobotKinematics()
         self._kinematics_lock = threading.Lock()
         self.grasp_flipped: dict[str, bool] = {}  # per arm: twin of the top-down grasp last used
@@ -134,7 +133,6 @@ class RobotBehaviours:
             raise ActionAbort(
                 ErrorCodes.BAD_GOAL, f"unknown motion {name!r}: known are {', '.join(self.motions.names())}"
             )
-        self.on_keyframe_motion()
         frames = self.motions.frames_for(name, arm)
         first = 0.0
         if name not in ("Home", "Tuck"):

@@ -69,7 +69,6 @@ class SimNode:
             speed_scale=lambda: float(node.get_parameter("speed_scale").value),
         )
         self.marker_motion = MarkerMotionBehaviour(world, self.behaviours, motions.hotel)
-        self.behaviours.on_keyframe_motion = self.marker_motion.forget
         self.actions = RobotActionServers(
             node,
             sim_thread,
