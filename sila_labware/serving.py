@@ -55,13 +55,13 @@ def start_sila_server(
     ``PORT_RELEASE_WAIT_S``.
     """
     deadline = time.monotonic() + PORT_RELEASE_WAIT_S
-    while not port_is_free(host, port) and time.monotonic() < deadline:
+    while not port_is_free(host, port):
+        if time.monotonic() >= deadline:
+            raise PortInUseError(
+                f"{host}:{port} is already in use (another sila-labware serve or bench?); "
+                "give this one other ports (--port-base or --port)"
+            )
         time.sleep(0.05)
-    if not port_is_free(host, port):
-        raise PortInUseError(
-            f"{host}:{port} is already in use (another sila-labware serve or bench?); "
-            "give this one other ports (--port-base or --port)"
-        )
     if authority is None:
         server.start_insecure(host, port, enable_discovery=discovery)
         return

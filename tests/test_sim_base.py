@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+from sim_steps import step_for
 
 from tiago_sim import robot_model as rm
 from tiago_sim import transforms as tf
@@ -84,9 +85,7 @@ def test_cancel_stops_the_base_and_reports_canceled():
     try:
         sim.run(sim.undock())
         motion = sim.drive_to(3.0, -1.0, 0.0)
-        cancel_at = sim.sim_time + 2.0  # mid-drive (steps are 1/240 to 1/60 s long)
-        while sim.sim_time < cancel_at:
-            sim.step()
+        step_for(sim, 2.0)  # mid-drive
         assert not motion.done
         motion.cancel()
         sim.run(motion)

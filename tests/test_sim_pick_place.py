@@ -12,7 +12,7 @@ import itertools
 import numpy as np
 import pybullet as p
 import pytest
-from sim_steps import step_lengths
+from sim_steps import step_for, step_lengths
 
 from tiago_sim import robot_model as rm
 from tiago_sim import transforms as tf
@@ -202,9 +202,7 @@ def test_a_plate_arriving_at_the_pocket_edge_settles_flat_in_the_nest():
         for side in (1, -1):
             for outwards_mm, yaw_deg in itertools.product(np.arange(-0.4, 1.65, 0.1), (0.0, 0.3)):
                 _rest_plate_on_pocket_edge(sim, side, outwards_mm / 1000, np.radians(yaw_deg))
-                settle_until = sim.sim_time + 2.0
-                while sim.sim_time < settle_until:
-                    sim.step()
+                step_for(sim, 2.0)
                 check = sim.check_placement(PLATE, "station_a", 2)
                 if not check.in_nest:
                     where = f"side {side:+d}, {outwards_mm:.1f} mm out, yaw {yaw_deg} deg"
