@@ -1,0 +1,326 @@
+"""Repeatability campaign: the demo transfer N times, each under its own seeded disturbances.
+
+Why: field reports give task success as attempts/successes with failures by cause (navigation
+drift, placements off by millimetres). This measures ours the same way, through the same SiLA
+servers and the same standard command order as `sila-labware demo` (demo.run_demo).
+
+One trial = a fresh deployment (sim node built from the trial seed's disturbed world, sequencer,
+bridge, SiLA servers), the demo transfer, then stop. A fresh start costs about 7 s against about
+17 s for the transfer (measured on 2 cores) and guarantees independent trials; resetting a running
+world in place would save that but has to put back every plate, joint and odometry state. Trial
+k of a campaign with seed S uses disturbance seed S + k, so `--replay S+k` repeats it alone.
+Disturbance levels are sent to the sim node as JSON in SI units (tiago_sim.measuring.disturbances reads
+them); here they are flags in mm, degrees and percent.
+
+Threads: runs on the caller's thread (the CLI's main thread).
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+import statistics
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
+from typing import Any, TextIO
+
+from sila_labware.deployment.demo import MISPLACED, DemoReport, run_demo
+from sila_labware.deployment.stack import Deployment, DeploymentOptions
+
+logger = logging.getLogger(__name__)
+
+CAUSES = ("positioning", "perception", "grasp", "navigation", "other")
+# Robot-side error codes (labware_interfaces/msg/ErrorCodes) -> failure cause of the success table.
+CAUSE_BY_ERROR_CODE = {
+    "NAVIGATION_FAILED": "navigation",
+    "DOCKED": "navigation",
+    "MARKER_NOT_FOUND": "perception",
+    "GRASP_FAILED": "grasp",
+    "PLATE_SLIPPED": "grasp",
+    "SLOT_EMPTY": "grasp",  # the plate the robot thought it had stowed is not on board
+    "IK_FAILED": "positioning",
+    "PLACE_FAILED": "positioning",
+    "NEST_OCCUPIED": "positioning",
+}
+BASE_MOTION_WORDS = ("driving to", "Dock", "Undock")
+
+
+@dataclass(frozen=True)
+class LevelFlag:
+    """One disturbance level: CLI flag in human units, its SI field for the sim node, the default."""
+
+    flag: str
+    field: str
+    to_si: float  # multiply the flag value by this to get the SI value
+    default: float  # in the flag's unit
+    help: str
+
+
+LEVEL_FLAGS = (
+    LevelFlag("--nav-error-mm", "navigation_xy_m", 1e-3, 30.0, "base stop error after navigation, per axis"),
+    LevelFlag(
+        "--nav-error-deg", "navigation_yaw_rad", math.pi / 180, 2.0, "base heading error after navigation"
+    ),
+    LevelFlag("--odometry-noise-pct", "odometry_noise", 1e-2, 0.2, "wheel radius error and slip per wheel"),
+    LevelFlag("--station-error-mm", "station_xy_m", 1e-3, 10.0, "station (table) placement error, per axis"),
+    LevelFlag("--station-error-deg", "station_yaw_rad", math.pi / 180, 1.0, "station heading error"),
+    LevelFlag("--marker-error-mm", "marker_xy_m", 1e-3, 1.0, "marker mounted off its place, per axis"),
+    LevelFlag("--marker-error-deg", "marker_yaw_rad", math.pi / 180, 0.5, "marker rotated in its plane"),
+    LevelFlag("--nest-error-mm", "nest_xy_m", 1e-3, 1.0, "nest row mounted off its place, per axis"),
+    LevelFlag("--nest-error-deg", "nest_yaw_rad", math.pi / 180, 0.3, "nest row rotated on the table"),
+    LevelFlag("--camera-noise", "camera_noise", 1.0, 2.0, "head camera read noise, 8-bit grey levels"),
+    LevelFlag("--plate-mass-pct", "plate_mass_spread", 1e-2, 10.0, "plate mass spread"),
+    LevelFlag("--plate-friction-pct", "plate_friction_spread", 1e-2, 15.0, "plate friction spread"),
+)
+
+
+def levels_json(values: dict[str, float]) -> str:
+    """Flag values (keyed by SI field name, human units) -> the sim node's --disturbance-levels."""
+    return json.dumps(
+        {level.field: values[level.field] * level.to_si for level in LEVEL_FLAGS}, sort_keys=True
+    )
+
+
+def default_level_values(scale: float = 1.0) -> dict[str, float]:
+    return {level.field: level.default * scale for level in LEVEL_FLAGS}
+
+
+def classify_failure(report: DemoReport) -> str:
+    """Failure cause of one trial from what the SiLA commands and the placement check said."""
+    error = report.error
+    if error.startswith(MISPLACED):  # the commands succeeded, the physics check disagrees
+        return "positioning"
+    for code, cause in CAUSE_BY_ERROR_CODE.items():
+        if code in error:
+            return cause
+    if "MOTION_FAILED" in error:
+        return "navigation" if any(word in error for word in BASE_MOTION_WORDS) else "positioning"
+    if any(word in error for word in BASE_MOTION_WORDS):
+        return "navigation"
+    return "other"
+
+
+@dataclass
+class TrialOutcome:
+    seed: int
+    success: bool
+    cause: str  # "" on success, else one of CAUSES
+    error: str
+    sim_seconds: float
+    wall_seconds: float
+    startup_wall_seconds: float
+    plate_position_error_mm: float | None
+    steps: list[dict[str, Any]] = field(default_factory=list)
+
+
+@dataclass
+class CampaignOptions:
+    stack: DeploymentOptions
+    seed: int
+    trials: int
+    levels: dict[str, float]  # SI field name -> value in the flag's unit
+    record_dir: Path | None = None  # frames of the first trial go here
+
+
+def run_trial(options: CampaignOptions, trial_seed: int, record_dir: Path | None = None) -> TrialOutcome:
+    """One fresh deployment, one standard transfer, stop. Never raises for a failed transfer."""
+    extra = ["--disturbance-seed", str(trial_seed), "--disturbance-levels", levels_json(options.levels)]
+    if record_dir is not None:
+        extra += ["--record-dir", str(record_dir)]
+    deployment = Deployment(replace(options.stack, extra_sim_arguments=extra))
+    started = time.monotonic()
+    try:
+        deployment.start()
+        startup_s = time.monotonic() - started
+        report = run_demo(deployment, progress_stream=None)
+    except Exception as error:  # noqa: BLE001 - a trial that cannot even start is an "other" failure
+        startup_s = time.monotonic() - started
+        report = DemoReport(error=f"could not start: {type(error).__name__}: {error}")
+    finally:
+        deployment.stop()
+    cause = "" if report.success else classify_failure(report)
+    return TrialOutcome(
+        seed=trial_seed,
+        success=report.success,
+        cause=cause,
+        error=report.error,
+        sim_seconds=report.sim_seconds,
+        wall_seconds=report.wall_seconds,
+        startup_wall_seconds=startup_s,
+        plate_position_error_mm=report.plate_position_error_mm,
+        steps=[asdict(step) for step in report.steps],
+    )
+
+
+class CampaignProgress:
+    """A progress bar on a terminal; one line per trial otherwise."""
+
+    def __init__(self, stream: TextIO | None, total: int) -> None:
+        self._stream = stream
+        self._total = total
+        self._interactive = bool(stream is not None and stream.isatty())
+        self._started = time.monotonic()
+
+    def update(self, outcomes: list[TrialOutcome]) -> None:
+        if self._stream is None or not outcomes:
+            return
+        done, last = len(outcomes), outcomes[-1]
+        successes = sum(outcome.success for outcome in outcomes)
+        elapsed = time.monotonic() - self._started
+        eta = elapsed / done * (self._total - done)
+        filled = int(round(30 * done / self._total))
+        counts = f"{done}/{self._total} ok {successes} failed {done - successes}"
+        bar = f"[{'#' * filled}{'.' * (30 - filled)}] {counts}"
+        if self._interactive:
+            self._stream.write(f"\r{bar}  {eta / 60:5.1f} min left ")
+            if done == self._total:
+                self._stream.write("\n")
+        else:
+            verdict = "ok" if last.success else f"FAILED ({last.cause})"
+            self._stream.write(f"{bar}: seed {last.seed} {verdict}, {last.sim_seconds:.1f} s sim\n")
+        self._stream.flush()
+
+
+def run_campaign(
+    options: CampaignOptions,
+    progress_stream: TextIO | None = sys.stderr,
+    on_trial: Callable[[TrialOutcome], None] | None = None,
+) -> list[TrialOutcome]:
+    """Trials with seeds seed, seed+1, ...; a failure is logged with its seed and the campaign goes on.
+
+    Ctrl-C (or SIGTERM, see the CLI) abandons the running trial, whose robot side and servers are
+    stopped on the way out, and returns the trials done so far: fewer than asked for."""
+    progress = CampaignProgress(progress_stream, options.trials)
+    outcomes: list[TrialOutcome] = []
+    for index in range(options.trials):
+        trial_seed = options.seed + index
+        record_dir = options.record_dir if index == 0 else None
+        try:
+            outcome = run_trial(options, trial_seed, record_dir)
+        except KeyboardInterrupt:
+            logger.warning(
+                "interrupted: trial seed %d abandoned, %d of %d trial(s) done",
+                trial_seed, len(outcomes), options.trials,
+            )  # fmt: skip
+            break
+        if not outcome.success:
+            logger.warning(
+                "trial seed %d failed (%s): %s; replay: sila-labware bench --replay %d",
+                trial_seed, outcome.cause, outcome.error, trial_seed,
+            )  # fmt: skip
+        outcomes.append(outcome)
+        progress.update(outcomes)
+        if on_trial is not None:
+            on_trial(outcome)
+    return outcomes
+
+
+def _median(values: list[float]) -> float:
+    return float(statistics.median(values)) if values else 0.0
+
+
+def summarize(outcomes: list[TrialOutcome], levels: dict[str, float], seed: int) -> dict[str, Any]:
+    """The success table and timings as one JSON-ready object."""
+    successes = sum(outcome.success for outcome in outcomes)
+    timed = [outcome for outcome in outcomes if outcome.success] or outcomes
+    failures = {cause: sum(outcome.cause == cause for outcome in outcomes) for cause in CAUSES}
+    sim_total = sum(outcome.sim_seconds for outcome in outcomes)
+    wall_total = sum(outcome.wall_seconds for outcome in outcomes)
+    phase_names = list(dict.fromkeys(step["name"] for outcome in outcomes for step in outcome.steps))
+    phases = {
+        name: {
+            "sim_seconds_median": _median(
+                [s["sim_seconds"] for o in outcomes for s in o.steps if s["name"] == name]
+            ),
+            "wall_seconds_median": _median(
+                [s["wall_seconds"] for o in outcomes for s in o.steps if s["name"] == name]
+            ),
+        }
+        for name in phase_names
+    }
+    delivered = [
+        o.plate_position_error_mm for o in outcomes if o.success and o.plate_position_error_mm is not None
+    ]
+    return {
+        "seed": seed,
+        "trials": len(outcomes),
+        "successes": successes,
+        "success_rate": successes / len(outcomes) if outcomes else 0.0,
+        "failures": failures,
+        # per delivered transfer (a failed trial stops early); all trials if none was delivered
+        "sim_seconds_median": _median([o.sim_seconds for o in timed]),
+        "wall_seconds_median": _median([o.wall_seconds for o in timed]),
+        "startup_wall_seconds_median": _median([o.startup_wall_seconds for o in outcomes]),
+        "sim_seconds_total": sim_total,
+        "wall_seconds_total": wall_total,
+        "campaign_wall_seconds": wall_total + sum(o.startup_wall_seconds for o in outcomes),
+        "realtime_factor": sim_total / wall_total if wall_total > 0 else 0.0,
+        "placement_error_mm_median": _median(delivered),
+        "placement_error_mm_max": max(delivered, default=0.0),
+        "phases": phases,
+        "failed_trials": [
+            {"seed": o.seed, "cause": o.cause, "error": o.error} for o in outcomes if not o.success
+        ],
+        "levels": levels,
+        "outcomes": [asdict(o) for o in outcomes],
+    }
+
+
+def format_table(summary: dict[str, Any]) -> str:
+    """The success table and timings as text (Markdown-compatible)."""
+    lines = [
+        "| attempts | successes | success rate | " + " | ".join(CAUSES) + " |",
+        "|---:|---:|---:|" + "---:|" * len(CAUSES),
+        f"| {summary['trials']} | {summary['successes']} | {100 * summary['success_rate']:.1f} % | "
+        + " | ".join(str(summary["failures"][cause]) for cause in CAUSES)
+        + " |",
+        "",
+        "| phase | simulated s (median) | wall s (median) |",
+        "|---|---:|---:|",
+    ]
+    for name, phase in summary["phases"].items():
+        lines.append(f"| {name} | {phase['sim_seconds_median']:.1f} | {phase['wall_seconds_median']:.1f} |")
+    lines.append(
+        f"| whole transfer (delivered) | {summary['sim_seconds_median']:.1f} | "
+        f"{summary['wall_seconds_median']:.1f} |"
+    )
+    lines += [
+        "",
+        f"total: {summary['sim_seconds_total']:.0f} s simulated, {summary['wall_seconds_total']:.0f} s wall "
+        f"in transfers (real-time factor {summary['realtime_factor']:.1f}); campaign wall time including "
+        f"a fresh start per trial ({summary['startup_wall_seconds_median']:.1f} s median): "
+        f"{summary['campaign_wall_seconds']:.0f} s",
+        f"placement error of delivered plates: median {summary['placement_error_mm_median']:.1f} mm, "
+        f"max {summary['placement_error_mm_max']:.1f} mm",
+    ]
+    for failed in summary["failed_trials"]:
+        lines.append(f"failed: seed {failed['seed']} ({failed['cause']}): {failed['error']}")
+    return "\n".join(lines)
+
+
+def format_targets(summary: dict[str, Any]) -> str:
+    """The issue's targets against what was measured (printed, never asserted)."""
+    wall_ratio = (
+        summary["wall_seconds_median"] / summary["sim_seconds_median"]
+        if summary["sim_seconds_median"]
+        else 0.0
+    )
+
+    enough = summary["success_rate"] >= 0.99 and summary["trials"] >= 200
+
+    def verdict(met: bool) -> str:
+        return "met" if met else "NOT met"
+
+    return "\n".join(
+        [
+            f"target >= 99 % success over 200 trials: {100 * summary['success_rate']:.1f} % over "
+            f"{summary['trials']} trials ({verdict(enough)})",
+            f"target <= 60 s simulated per transfer: {summary['sim_seconds_median']:.1f} s median "
+            f"({verdict(summary['sim_seconds_median'] <= 60.0)})",
+            f"target wall <= 1/10 of simulated: {wall_ratio:.3f} ({verdict(0 < wall_ratio <= 0.1)})",
+        ]
+    )

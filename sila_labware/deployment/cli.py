@@ -1,0 +1,312 @@
+"""Command line entry point `sila-labware`: serve the robot and its stations over SiLA, or run the demo.
+
+    sila-labware serve --world FILE [--host 127.0.0.1] [--port-base N] [--insecure] [--ca-file PATH]
+    sila-labware demo  --world FILE [--json] [--record DIR] [same options as serve]
+    sila-labware bench --trials N --seed S [--json] [--report DIR] [--replay SEED] [levels] (bench_cli)
+    sila-labware bluesky-demo --world FILE   (the same robot driven from a Bluesky RunEngine plan)
+
+Exit codes: 0 success, 1 the demo transfer failed or the stack could not start, 2 bad usage.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import signal
+import sys
+import tempfile
+import threading
+from collections.abc import Sequence
+from pathlib import Path
+from types import FrameType
+from typing import TYPE_CHECKING
+
+from sila_labware.benchmarks.campaign_cli import (
+    add_bench_arguments,
+    bench_command,
+    temporary_ca_file,
+    validate_bench,
+    write_recorded_pictures,
+)
+
+if TYPE_CHECKING:
+    from sila_labware.deployment.stack import Deployment
+
+logger = logging.getLogger("sila_labware")
+
+DEFAULT_WORLD = Path(__file__).resolve().parents[2] / "tiago_sim" / "worlds" / "default.yaml"
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse, but usage errors are one line: `sila-labware: error: <reason>`."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(
+        prog="sila-labware", description="A TIAGo++ mobile manipulator as a SiLA 2 labware-transfer device."
+    )
+    subcommands = parser.add_subparsers(
+        dest="command", required=True, metavar="{serve,demo,bluesky-demo,bench}", parser_class=_Parser
+    )
+
+    def add_stack_options(sub: argparse.ArgumentParser) -> None:
+        sub.add_argument(
+            "--world", type=Path, default=DEFAULT_WORLD, help="world YAML (default: the bundled lab)"
+        )
+        sub.add_argument(
+            "--host", default="127.0.0.1", help="address the SiLA servers bind (default: %(default)s)"
+        )
+        sub.add_argument(
+            "--port-base",
+            type=int,
+            default=50052,
+            help="robot server port; stations follow (default: %(default)s)",
+        )
+        sub.add_argument(
+            "--insecure", action="store_true", help="no TLS (tests only; the standard forbids it)"
+        )
+        sub.add_argument(
+            "--ca-file",
+            type=Path,
+            default=None,
+            help="where to write the CA certificate clients trust "
+            "(default: ./sila-labware-ca.pem for serve, a temporary file for demo)",
+        )
+        sub.add_argument("--no-discovery", action="store_true", help="do not announce the servers (mDNS)")
+        sub.add_argument(
+            "--domain-id", type=int, default=None, help="ROS domain (default: $ROS_DOMAIN_ID or random)"
+        )
+        sub.add_argument(
+            "--log-dir", type=Path, default=None, help="write the robot side's output to files here"
+        )
+        sub.add_argument(
+            "--ready-timeout", type=float, default=180.0, help="seconds to wait for the robot side"
+        )
+        sub.add_argument("--verbose", action="store_true", help="log at INFO level")
+
+    serve = subcommands.add_parser(
+        "serve", help="run the simulated robot and serve it and its stations over SiLA"
+    )
+    add_stack_options(serve)
+    demo = subcommands.add_parser(
+        "demo", help="serve, then move the plate from the first station to the second"
+    )
+    add_stack_options(demo)
+    demo.add_argument(
+        "--json", action="store_true", help="print one JSON object with the outcome and timings"
+    )
+    demo.add_argument(
+        "--record", type=Path, default=None, metavar="DIR", help="write pictures of the run here"
+    )
+    bench = subcommands.add_parser("bench", help="repeat the demo transfer under seeded disturbances")
+    add_stack_options(bench)
+    add_bench_arguments(bench)
+    bluesky = subcommands.add_parser(
+        "bluesky-demo",
+        help="run the robot side and a Bluesky plan: pickup, place, measure, return the plate",
+    )
+    bluesky.add_argument(
+        "--world", type=Path, default=DEFAULT_WORLD, help="world YAML (default: the bundled lab)"
+    )
+    bluesky.add_argument(
+        "--domain-id", type=int, default=None, help="ROS domain (default: $ROS_DOMAIN_ID or random)"
+    )
+    bluesky.add_argument(
+        "--log-dir", type=Path, default=None, help="write the robot side's output to files here"
+    )
+    bluesky.add_argument(
+        "--ready-timeout", type=float, default=180.0, help="seconds to wait for the robot side"
+    )
+    bluesky.add_argument("--verbose", action="store_true", help="log at INFO level")
+    bluesky.set_defaults(port_base=50052)
+    return parser
+
+
+def _validate(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    if not args.world.is_file():
+        parser.error(f"world file not found: {args.world}")
+    if not 1 <= args.port_base <= 65535 - 16:
+        parser.error(f"--port-base {args.port_base} is not a usable port")
+    if args.domain_id is not None and not 0 <= args.domain_id <= 232:
+        parser.error(f"--domain-id {args.domain_id} is outside 0..232")
+    if args.command == "bench":
+        validate_bench(parser, args)
+
+
+class _StopRequest:
+    """SIGINT/SIGTERM set a flag (and interrupt waits) instead of killing the process mid-way."""
+
+    def __init__(self) -> None:
+        self.event = threading.Event()
+
+    def install(self) -> None:
+        signal.signal(signal.SIGINT, self._handle)
+        signal.signal(signal.SIGTERM, self._handle)
+
+    def _handle(self, signum: int, _frame: FrameType | None) -> None:
+        logger.info("signal %d: stopping", signum)
+        self.event.set()
+
+
+def _deployment_from(args: argparse.Namespace):
+    from sila_labware.deployment.stack import Deployment, DeploymentOptions
+
+    if args.insecure:
+        logger.warning(
+            "serving WITHOUT encryption (--insecure): for tests only, the SiLA standard forbids it"
+        )
+    return Deployment(
+        DeploymentOptions(
+            world=args.world,
+            host=args.host,
+            port_base=args.port_base,
+            insecure=args.insecure,
+            ca_file=_ca_file(args),
+            discovery=not args.no_discovery,
+            domain_id=args.domain_id,
+            ready_timeout_s=args.ready_timeout,
+            log_dir=args.log_dir,
+            extra_sim_arguments=_record_arguments(args),
+        )
+    )
+
+
+def _record_arguments(args: argparse.Namespace) -> list[str]:
+    record = getattr(args, "record", None)
+    return [] if record is None else ["--record-dir", str(record / "frames")]
+
+
+def _ca_file(args: argparse.Namespace) -> Path:
+    if args.ca_file is not None:
+        return args.ca_file
+    if args.command == "bench":
+        return temporary_ca_file()
+    if args.command == "demo":
+        return Path(tempfile.mkdtemp(prefix="sila-labware-demo-")) / "ca.pem"
+    return Path("sila-labware-ca.pem")
+
+
+def _print_servers(deployment, stream) -> None:
+    for served in deployment.servers:
+        stream.write(f"{served.role:8} {served.name:32} {served.host}:{served.port}\n")
+    if deployment.ca_file is not None:
+        stream.write(f"CA file for clients: {deployment.ca_file.resolve()}\n")
+    for child in deployment.children.children:
+        stream.write(f"robot side: {child.name} pid {child.popen.pid}\n")
+    stream.write(f"ROS domain: {deployment.domain_id}\n")
+    stream.flush()
+
+
+def _start(args: argparse.Namespace) -> tuple[Deployment | None, _StopRequest]:
+    """Start the deployment; None if it could not start (the reason is on stderr) or was stopped
+    while starting (then the stop request is set)."""
+    stop = _StopRequest()
+    stop.install()
+    deployment = _deployment_from(args)
+    try:
+        deployment.start(should_stop=stop.event.is_set)
+    except KeyboardInterrupt:
+        stop.event.set()
+        return None, stop
+    except Exception as error:  # noqa: BLE001 - one line for the user, details in the log
+        logger.debug("start failed", exc_info=True)
+        sys.stderr.write(f"sila-labware: could not start: {error}\n")
+        return None, stop
+    return deployment, stop
+
+
+def serve(args: argparse.Namespace) -> int:
+    deployment, stop = _start(args)
+    if deployment is None:
+        return 0 if stop.event.is_set() else 1
+    try:
+        _print_servers(deployment, sys.stdout)
+        sys.stdout.write("serving; Ctrl-C stops\n")
+        sys.stdout.flush()
+        while not stop.event.wait(0.5):
+            deployment.check_healthy()
+        return 0
+    except Exception as error:  # noqa: BLE001
+        sys.stderr.write(f"sila-labware: {error}\n")
+        return 1
+    finally:
+        deployment.stop()
+
+
+def demo(args: argparse.Namespace) -> int:
+    from sila_labware.deployment.demo import run_demo
+
+    deployment, _stop = _start(args)
+    if deployment is None:
+        return 1
+    try:
+        _print_servers(deployment, sys.stderr)
+        report = run_demo(deployment, progress_stream=sys.stderr)
+    finally:
+        deployment.stop()
+    if args.record is not None:
+        write_recorded_pictures(args.record)
+    if args.json:
+        sys.stdout.write(json.dumps(report.as_json_object()) + "\n")
+    else:
+        outcome = "plate delivered" if report.success else f"FAILED: {report.error}"
+        error_mm = report.plate_position_error_mm
+        detail = f" (position error {error_mm:.1f} mm)" if error_mm is not None else ""
+        sys.stdout.write(
+            f"{outcome}{detail}; {report.wall_seconds:.1f} s wall, {report.sim_seconds:.1f} s simulated\n"
+        )
+    return 0 if report.success else 1
+
+
+def bluesky_demo(args: argparse.Namespace) -> int:
+    """Robot side only (no SiLA): the beamline paper's plan on a RunEngine against the simulation."""
+    from ros_bridge.bluesky.demo import run_bluesky_demo
+    from sila_labware.deployment.processes import ProcessGroup, ros_environment
+    from sila_labware.deployment.stack import choose_domain_id, join_ros_domain, start_robot_side
+
+    domain_id = choose_domain_id(args.domain_id)
+    join_ros_domain(domain_id)
+    with ProcessGroup(ros_environment(domain_id), args.log_dir) as children:
+        start_robot_side(children, args.world)
+        sys.stderr.write(f"robot side started (ROS domain {domain_id}); running the Bluesky plan\n")
+        return run_bluesky_demo(
+            args.world, domain_id=domain_id, ready_timeout_s=args.ready_timeout, progress_bar=True
+        )
+
+
+def _bench(args: argparse.Namespace) -> int:
+    from sila_labware.deployment.processes import interrupt_between_starts
+
+    # Ctrl-C and SIGTERM unwind the running trial: its robot side (own sessions, so a terminal's
+    # Ctrl-C never reaches it) is stopped on the way out instead of being left running.
+    signal.signal(signal.SIGINT, interrupt_between_starts)
+    signal.signal(signal.SIGTERM, interrupt_between_starts)
+    return bench_command(args, _deployment_from(args).options)
+
+
+COMMANDS = {"serve": serve, "demo": demo, "bluesky-demo": bluesky_demo, "bench": _bench}
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    _validate(parser, args)
+    logging.basicConfig(
+        level=logging.INFO if args.verbose else logging.WARNING,
+        format="%(asctime)s %(levelname)s %(name)s: %(message)s",
+    )
+    if not args.verbose:
+        # sila2 logs every defined error a client receives as a server-side traceback.
+        logging.getLogger("sila2").setLevel(logging.CRITICAL)
+    if args.command == "bluesky-demo":
+        # bluesky's own loggers report every state change at INFO
+        logging.getLogger("bluesky").setLevel(logging.INFO if args.verbose else logging.WARNING)
+    return COMMANDS[args.command](args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,205 @@
+"""Everything `sila-labware serve` runs: robot-side ROS nodes, the ROS bridge, the SiLA servers.
+
+Order of start: the robot side as child processes (simulation node, task sequencer), the bridge's
+ROS runtime in this process, a wait until every ROS server answers, then one SiLA server for the
+robot and one per station the robot side describes. `stop()` undoes it in reverse, quickly.
+
+Threads: `start`/`stop` run on the caller's thread; the bridge adds one ROS thread; each SiLA
+server has its own gRPC thread pool.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import threading
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from sila2.server import SilaServer
+
+from ros_bridge.domain import reserve_domain_id
+from ros_bridge.errors import BridgeError
+from ros_bridge.robot_link import RobotLink
+from ros_bridge.runtime import RosRuntime
+from ros_bridge.workcell import WorkcellDescription
+from sila_labware.deployment.processes import ProcessGroup, ros_environment
+from sila_labware.deployment.supervisor import RobotSideSupervisor
+from sila_labware.device.robot_controller import RobotController
+from sila_labware.device.station_controller import StationController
+from sila_labware.servers.robot_server.server import Server as RobotServer
+from sila_labware.servers.serving import start_sila_server
+from sila_labware.servers.station_server.server import Server as StationServer
+from sila_labware.servers.tls import CertificateAuthority
+
+logger = logging.getLogger(__name__)
+
+ROBOT_SIDE_MODULES = (("sim_node", "tiago_sim.sim_node"), ("sequencer", "tiago_sim.sequencer"))
+
+
+@dataclass
+class DeploymentOptions:
+    world: Path
+    host: str = "127.0.0.1"
+    port_base: int = 50052
+    insecure: bool = False
+    ca_file: Path = Path("sila-labware-ca.pem")
+    discovery: bool = True
+    domain_id: int | None = None
+    ready_timeout_s: float = 180.0
+    log_dir: Path | None = None
+    extra_sim_arguments: list[str] = field(default_factory=list)
+    restart_robot_side: bool = True
+    """Restart the robot side when a child ends (see sila_labware.deployment.supervisor)."""
+
+
+@dataclass(frozen=True)
+class ServedServer:
+    """One running SiLA server, as clients reach it."""
+
+    name: str
+    role: str  # "robot" or "station"
+    station: str  # station name for station servers, empty for the robot
+    host: str
+    port: int
+    server: SilaServer
+
+
+def choose_domain_id(requested: int | None) -> int:
+    """The requested id, else ROS_DOMAIN_ID from the environment, else one reserved for this process."""
+    if requested is not None:
+        return requested
+    if os.environ.get("ROS_DOMAIN_ID", "").isdigit():
+        return int(os.environ["ROS_DOMAIN_ID"])
+    return reserve_domain_id()
+
+
+def start_robot_side(children: ProcessGroup, world: Path, extra_sim_arguments: Sequence[str] = ()) -> None:
+    """Start the robot side's ROS nodes (simulation node, sequencer) as children."""
+    for name, module in ROBOT_SIDE_MODULES:
+        arguments = ["--world", str(world)]
+        if name == "sim_node":
+            arguments += list(extra_sim_arguments)
+        children.start_python_module(name, module, arguments)
+
+
+def join_ros_domain(domain_id: int) -> None:
+    """Put this process's own ROS participants (the bridge) into the deployment's domain."""
+    os.environ.update(
+        {key: value for key, value in ros_environment(domain_id).items() if key.startswith(("ROS_", "RMW_"))}
+    )
+
+
+class Deployment:
+    """Start and stop the whole stack; reach its parts (link, robot, servers) while it runs."""
+
+    def __init__(self, options: DeploymentOptions) -> None:
+        self.options = options
+        self.domain_id = choose_domain_id(options.domain_id)
+        self.children = ProcessGroup(ros_environment(self.domain_id), options.log_dir)
+        self.runtime: RosRuntime | None = None
+        self.link: RobotLink | None = None
+        self.workcell: WorkcellDescription | None = None
+        self.robot: RobotController | None = None
+        self.servers: list[ServedServer] = []
+        self.ca_file: Path | None = None
+        self.supervisor: RobotSideSupervisor | None = None
+
+    def start(self, should_stop: Callable[[], bool] = lambda: False) -> None:
+        """Bring everything up; on any failure, stop what was started and re-raise."""
+        try:
+            self._start_robot_side()
+            self._start_bridge(should_stop)
+            self._start_servers()
+            if self.options.restart_robot_side:
+                assert self.link is not None and self.robot is not None
+                self.supervisor = RobotSideSupervisor(
+                    self.children, self._start_robot_side, self.link, self.robot
+                ).start()
+        except BaseException:
+            self.stop()
+            raise
+
+    def _start_robot_side(self) -> None:
+        start_robot_side(self.children, self.options.world, self.options.extra_sim_arguments)
+
+    def _start_bridge(self, should_stop: Callable[[], bool]) -> None:
+        join_ros_domain(self.domain_id)
+        self.runtime = RosRuntime("sila_labware_bridge", domain_id=self.domain_id).start()
+        self.link = RobotLink(self.runtime)
+        deadline = time.monotonic() + self.options.ready_timeout_s
+        while True:
+            self.children.check_running()
+            if should_stop():
+                raise KeyboardInterrupt
+            try:
+                self.link.wait_until_ready(timeout_s=1.0)
+                break
+            except BridgeError as error:
+                if time.monotonic() > deadline:
+                    raise BridgeError(
+                        f"the robot side did not come up within {self.options.ready_timeout_s:.0f} s: {error}"
+                    ) from error
+        self.workcell = self.link.describe_workcell()
+        if not self.workcell.stations:
+            raise BridgeError("the robot side describes no stations")
+        self.robot = RobotController(self.link, self.workcell)
+
+    def _start_servers(self) -> None:
+        assert self.robot is not None and self.workcell is not None and self.link is not None
+        planned: list[tuple[SilaServer, str, str]] = [(RobotServer(self.robot), "robot", "")]
+        for station in self.workcell.stations:
+            planned.append((StationServer(StationController(self.link, station)), "station", station.name))
+        authority = None if self.options.insecure else CertificateAuthority()
+        for offset, (server, role, station_name) in enumerate(planned):
+            port = self.options.port_base + offset
+            start_sila_server(
+                server, self.options.host, port, authority=authority, discovery=self.options.discovery
+            )
+            self.servers.append(
+                ServedServer(server.server_name, role, station_name, self.options.host, port, server)
+            )
+        if authority is not None:
+            self.ca_file = authority.write_certificate(self.options.ca_file)
+
+    def check_healthy(self) -> None:
+        """Raise if the robot side is down for good (the supervisor gave up, or there is none)."""
+        if self.supervisor is None:
+            self.children.check_running()
+        elif self.supervisor.failure:
+            raise RuntimeError(self.supervisor.failure)
+
+    def robot_server(self) -> ServedServer:
+        return next(served for served in self.servers if served.role == "robot")
+
+    def station_server(self, station: str) -> ServedServer:
+        return next(served for served in self.servers if served.station == station)
+
+    def stop(self) -> None:
+        """Stop servers (in parallel), the bridge, then the children; about 3 s at worst."""
+        if self.supervisor is not None:
+            self.supervisor.stop()
+            self.supervisor = None
+        stoppers = [
+            threading.Thread(target=_stop_server, args=(served.server,), daemon=True)
+            for served in self.servers
+        ]
+        for stopper in stoppers:
+            stopper.start()
+        for stopper in stoppers:
+            stopper.join(2.0)
+        self.servers.clear()
+        if self.runtime is not None:
+            self.runtime.stop(timeout_s=1.0)
+            self.runtime = None
+        self.children.stop(timeout_s=2.0)
+
+
+def _stop_server(server: SilaServer) -> None:
+    try:
+        if server.running:
+            server.stop(grace_period=0.2)
+    except Exception:  # noqa: BLE001 - stopping anyway; the reason goes to the log
+        logger.warning("stopping SiLA server %s raised", server.server_name, exc_info=True)

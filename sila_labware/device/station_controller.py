@@ -1,0 +1,104 @@
+"""A station's behaviour behind its LabwareTransferSiteController: a digital twin of a passive device.
+
+The twin keeps the protocol order per nest (`SiteSequence`) and takes occupancy from the
+station's nest sensors as the robot side publishes them on /station_states. Decisions it makes
+from that sensor (documented for clients):
+
+- PrepareForInput is refused with InvalidCommandSequence while the nest is occupied;
+- PrepareForOutput is refused with InvalidCommandSequence while the nest is empty;
+- LabwareDelivered / LabwareRemoved are refused with InvalidCommandSequence if, within
+  `settle_timeout_s`, the sensor does not confirm the plate arrived / left. The nest then stays
+  prepared, so the client may send the command again once the plate is really there / gone.
+
+A station has no internal positions of its own; InternalPosition must be 1 (the standard's rule
+for devices without internal positions).
+
+Threads: methods run on SiLA handler threads and only read the bridge's topic mirror.
+"""
+
+from __future__ import annotations
+
+import logging
+
+from ros_bridge.errors import BridgeTimeout
+from ros_bridge.robot_link import RobotLink
+from ros_bridge.workcell import NestOccupancy, StationDescription
+from sila_labware.device.errors import CommandSequenceError
+from sila_labware.device.sequences import NestExpectation, NestPhase, SiteSequence
+from sila_labware.device.validation import check_handover, check_internal_position, check_text
+
+logger = logging.getLogger(__name__)
+
+STATION_INTERNAL_POSITIONS = 1
+
+
+class StationController:
+    """One station: its name, its nests, and their protocol state."""
+
+    def __init__(self, link: RobotLink, station: StationDescription, settle_timeout_s: float = 5.0) -> None:
+        self.link = link
+        self.station = station
+        self.settle_timeout_s = settle_timeout_s
+        self.sequence = SiteSequence(station.name, station.sub_positions)
+
+    def handover_positions(self) -> list[tuple[str, int]]:
+        return [(self.station.name, self.station.sub_positions)]
+
+    @property
+    def internal_positions(self) -> int:
+        return STATION_INTERNAL_POSITIONS
+
+    def prepare_for_input(
+        self, position: str, sub_position: int, internal_position: int, labware_type: str, labware_id: str
+    ) -> None:
+        sub_position = self._check_handover(position, sub_position)
+        check_internal_position(internal_position, self.internal_positions)
+        check_text(labware_type, "LabwareType", allow_empty=True)
+        check_text(labware_id, "LabwareUniqueID", allow_empty=True)
+        occupied = self.nest(sub_position).occupied
+        self.sequence.prepare_for_input(sub_position, internal_position, labware_type, labware_id, occupied)
+
+    def prepare_for_output(self, position: str, sub_position: int, internal_position: int) -> None:
+        sub_position = self._check_handover(position, sub_position)
+        check_internal_position(internal_position, self.internal_positions)
+        self.sequence.prepare_for_output(sub_position, internal_position, self.nest(sub_position).occupied)
+
+    def labware_delivered(self, position: str, sub_position: int) -> NestExpectation:
+        sub_position = self._check_handover(position, sub_position)
+        self._require_phase_then_sensor(sub_position, "LabwareDelivered", want_occupied=True)
+        return self.sequence.labware_delivered(sub_position)
+
+    def labware_removed(self, position: str, sub_position: int) -> NestExpectation:
+        sub_position = self._check_handover(position, sub_position)
+        self._require_phase_then_sensor(sub_position, "LabwareRemoved", want_occupied=False)
+        return self.sequence.labware_removed(sub_position)
+
+    def nest(self, sub_position: int) -> NestOccupancy:
+        """The sensor reading of one nest (a nest missing from the report counts as empty)."""
+        for nest in self.link.nest_occupancies():
+            if nest.station == self.station.name and nest.sub_position == sub_position:
+                return nest
+        logger.warning("no sensor reading for %s/%d; treating it as empty", self.station.name, sub_position)
+        return NestOccupancy(self.station.name, sub_position, False, "")
+
+    def _check_handover(self, position: str, sub_position: int) -> int:
+        return check_handover(
+            position, sub_position, {self.station.name: self.station.sub_positions}
+        ).sub_position
+
+    def _require_phase_then_sensor(self, sub_position: int, command: str, want_occupied: bool) -> None:
+        # Order first (a wrong order is reported as such, without waiting for the sensor).
+        required = NestPhase.PREPARED_FOR_INPUT if want_occupied else NestPhase.PREPARED_FOR_OUTPUT
+        if self.sequence.nest(sub_position).phase is not required:
+            if want_occupied:
+                self.sequence.labware_delivered(sub_position)  # raises the ordering error
+            else:
+                self.sequence.labware_removed(sub_position)
+        try:
+            self.link.wait_for_nest(self.station.name, sub_position, want_occupied, self.settle_timeout_s)
+        except BridgeTimeout as error:
+            state = "still sees no plate" if want_occupied else "still sees a plate"
+            raise CommandSequenceError(
+                f"{command} refused: the sensor of nest {self.station.name}/{sub_position} {state} "
+                f"after {self.settle_timeout_s:.0f} s"
+            ) from error

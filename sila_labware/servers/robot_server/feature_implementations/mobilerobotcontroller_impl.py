@@ -1,0 +1,130 @@
+"""MobileRobotController: base motions around the handovers, and what the robot is and carries.
+
+Commands go to `RobotController` (dock, undock, drive, stop); the observable properties follow
+the robot side's /robot_state through the bridge's topic mirror. Listeners run on the ROS thread
+and only push values into sila2's queues.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable
+from typing import TYPE_CHECKING
+
+from sila2.server import MetadataDict, ObservableCommandInstance
+
+from ros_bridge.workcell import RobotStatus
+from sila_labware.device.errors import CommandSequenceError, ParameterError
+from sila_labware.device.robot_controller import MotionFailed
+from sila_labware.servers.sila_glue import COMMAND_LIFETIME, progress_reporter, validation_error
+
+from ..generated.mobilerobotcontroller import (
+    Dock_Responses,
+    DockingFailed,
+    DriveToPointOfInterest_Responses,
+    MobileRobotControllerBase,
+    MobileRobotControllerFeature,
+    MotionStopped,
+    NavigationFailed,
+    PointOfInterestName,
+    RobotBusy,
+    RobotDocked,
+    StopMotion_Responses,
+    Undock_Responses,
+    UndockingFailed,
+    UnknownPointOfInterest,
+)
+
+if TYPE_CHECKING:
+    from ..server import Server
+
+logger = logging.getLogger(__name__)
+
+SILA_ROBOT_STATES = {
+    "docked": "Docked",
+    "idle": "Idle",
+    "navigating": "Navigating",
+    "manipulating": "Manipulating",
+    "error": "Error",
+}
+
+
+def onboard_items(status: RobotStatus) -> list[dict[str, object]]:
+    """OnboardLabware: one entry per occupied hotel slot, in slot order."""
+    return [
+        {"InternalPosition": slot.index, "LabwareUniqueID": slot.labware_id, "LabwareType": slot.labware_type}
+        for slot in sorted(status.hotel, key=lambda slot: slot.index)
+        if slot.labware_id
+    ]
+
+
+class MobileRobotControllerImpl(MobileRobotControllerBase):
+    def __init__(self, parent_server: Server) -> None:
+        super().__init__(parent_server=parent_server)
+        self.robot = parent_server.robot
+        self.Dock_default_lifetime_of_execution = COMMAND_LIFETIME
+        self.Undock_default_lifetime_of_execution = COMMAND_LIFETIME
+        self.DriveToPointOfInterest_default_lifetime_of_execution = COMMAND_LIFETIME
+        # Subscribers wait forever without a first value: publish the current state now.
+        self._publish_status(self.robot.link.robot_status())
+        self.robot.link.on_robot_status(self._publish_status)
+
+    def _publish_status(self, status: RobotStatus) -> None:
+        self.update_RobotPose({"X": status.x_m, "Y": status.y_m, "Theta": status.theta_rad})
+        self.update_RobotState(SILA_ROBOT_STATES.get(status.state, "Error"))
+        self.update_CurrentPointOfInterest(status.current_poi[:255])
+        self.update_OnboardLabware(onboard_items(status))
+
+    def get_PointsOfInterest(self, *, metadata: MetadataDict) -> list[PointOfInterestName]:
+        return list(self.robot.workcell.pois)
+
+    def StopMotion(self, *, metadata: MetadataDict) -> StopMotion_Responses:
+        self.robot.stop_motion()
+        return StopMotion_Responses()
+
+    def Dock(self, *, metadata: MetadataDict, instance: ObservableCommandInstance) -> Dock_Responses:
+        instance.begin_execution()
+        if self.robot.link.robot_status().docked:
+            return Dock_Responses()
+        self._run("Dock", lambda: self.robot.dock(progress_reporter(instance)), DockingFailed)
+        return Dock_Responses()
+
+    def Undock(self, *, metadata: MetadataDict, instance: ObservableCommandInstance) -> Undock_Responses:
+        instance.begin_execution()
+        if not self.robot.link.robot_status().docked:
+            return Undock_Responses()
+        self._run("Undock", lambda: self.robot.undock(progress_reporter(instance)), UndockingFailed)
+        return Undock_Responses()
+
+    def DriveToPointOfInterest(
+        self,
+        PointOfInterest: PointOfInterestName,
+        *,
+        metadata: MetadataDict,
+        instance: ObservableCommandInstance,
+    ) -> DriveToPointOfInterest_Responses:
+        instance.begin_execution()
+        self._run(
+            "DriveToPointOfInterest",
+            lambda: self.robot.drive_to_poi(PointOfInterest, progress_reporter(instance)),
+            NavigationFailed,
+        )
+        return DriveToPointOfInterest_Responses()
+
+    def _run(self, command: str, motion: Callable[[], None], failure: type[Exception]) -> None:
+        try:
+            motion()
+        except CommandSequenceError as error:
+            raise RobotBusy(str(error)) from error
+        except ParameterError as error:
+            raise validation_error(MobileRobotControllerFeature, command, error) from error
+        except MotionFailed as error:
+            if error.error_code == "UNKNOWN_POI":
+                raise UnknownPointOfInterest(error.message) from error
+            if error.error_code == "DOCKED":
+                raise RobotDocked(error.message) from error
+            if error.error_code == "BUSY":
+                raise RobotBusy(error.message) from error
+            if error.error_code == "CANCELED":
+                raise MotionStopped(error.message) from error
+            raise failure(error.message) from error

@@ -1,0 +1,57 @@
+"""Small translations between our robot logic and the sila2 library, shared by both servers.
+
+Threads: `progress_reporter`'s callable is called on the ROS thread (action feedback); sila2's
+command instance notifies subscribers itself, so the call is short.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+from datetime import timedelta
+
+from sila2.framework import ValidationError
+from sila2.framework.feature import Feature
+from sila2.framework.fully_qualified_identifier import FullyQualifiedCommandParameterIdentifier
+from sila2.server import ObservableCommandInstance
+
+from sila_labware.device.errors import ParameterError
+from sila_labware.device.robot_controller import ProgressReport
+
+COMMAND_LIFETIME = timedelta(minutes=10)
+"""How long a finished observable command's result stays available to clients, counted from its
+start. sila2 keeps one waiting thread per command for this long, so it bounds the threads of a
+busy server (a transfer runs 8 commands: at one transfer per 12 s, about 400 threads)."""
+
+logger = logging.getLogger(__name__)
+
+
+def validation_error(feature: Feature, command: str, error: ParameterError) -> ValidationError:
+    """A SiLA validation error naming the parameter (as clients expect it, fully qualified)."""
+    validation = ValidationError(error.message)
+    validation.parameter_fully_qualified_identifier = FullyQualifiedCommandParameterIdentifier(
+        f"{feature.fully_qualified_identifier}/Command/{command}/Parameter/{error.parameter}"
+    )
+    return validation
+
+
+def progress_reporter(instance: ObservableCommandInstance) -> ProgressReport:
+    """Feed (progress, remaining seconds) into a command instance; progress never goes down."""
+    lock = threading.Lock()
+    highest = [0.0]
+
+    def report(progress: float, remaining_s: float) -> None:
+        with lock:
+            highest[0] = max(highest[0], min(1.0, max(0.0, progress)))
+            try:
+                instance.progress = highest[0]
+                instance.estimated_remaining_time = timedelta(seconds=max(0.0, remaining_s))
+            except Exception:  # noqa: BLE001 - a closed instance must not break the ROS thread
+                logger.debug("could not update a command instance", exc_info=True)
+
+    return report
+
+
+def handover_position(position: str, sub_position: int) -> dict[str, object]:
+    """The standard's HandoverPosition structure as sila2 takes it."""
+    return {"Position": position, "SubPosition": sub_position}

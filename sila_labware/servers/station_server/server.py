@@ -1,0 +1,46 @@
+# Created by sila2.code_generator 0.14.0 (new-package); hand-maintained since: regeneration never touches it.
+
+"""One station's SiLA server: the standard's passive-side feature, backed by a `StationController`."""
+
+from __future__ import annotations
+
+from uuid import UUID, uuid4
+
+from sila2.server import SilaServer
+
+from sila_labware.device.station_controller import StationController
+
+from .feature_implementations.labwaretransfersitecontroller_impl import LabwareTransferSiteControllerImpl
+from .generated.labwaretransfersitecontroller import LabwareTransferSiteControllerFeature
+
+
+class Server(SilaServer):
+    def __init__(
+        self,
+        station: StationController,
+        server_uuid: UUID | None = None,
+        name: str | None = None,
+        description: str | None = None,
+    ):
+        if name is None:
+            name = f"Station {station.station.name}"
+        if description is None:
+            description = (
+                "A passive lab station whose plate nests a robot loads and unloads "
+                "(SiLA labware transfer, passive side)."
+            )
+        super().__init__(
+            server_name=name,
+            server_description=description,
+            server_type="LabwareStation",
+            server_version="0.1",
+            server_vendor_url="https://github.com/sila-labware/sila-labware",
+            server_uuid=server_uuid if server_uuid is not None else uuid4(),
+        )
+
+        self.station = station
+
+        self.labwaretransfersitecontroller = LabwareTransferSiteControllerImpl(self)
+        self.set_feature_implementation(
+            LabwareTransferSiteControllerFeature, self.labwaretransfersitecontroller
+        )

@@ -1,0 +1,146 @@
+"""The `sila-labware` command: usage errors, `serve` under signals, `demo --json`."""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+from sila2.client import SilaClient
+
+from tests.helpers.sila_stack import free_port_base
+
+CLI = [sys.executable, "-m", "sila_labware.deployment.cli"]
+
+
+def run_cli(*arguments: str, timeout_s: float = 30.0) -> subprocess.CompletedProcess:
+    return subprocess.run([*CLI, *arguments], capture_output=True, text=True, timeout=timeout_s)
+
+
+def test_help_lists_subcommands() -> None:
+    done = run_cli("--help")
+    assert done.returncode == 0
+    assert "serve" in done.stdout and "demo" in done.stdout
+    serve_help = run_cli("serve", "--help")
+    for option in ("--world", "--host", "--port-base", "--insecure", "--ca-file"):
+        assert option in serve_help.stdout
+    assert "--json" in run_cli("demo", "--help").stdout
+
+
+@pytest.mark.parametrize(
+    ("arguments", "reason"),
+    [
+        ((), "the following arguments are required"),
+        (("fly",), "invalid choice: 'fly'"),
+        (("serve", "--bogus"), "unrecognized arguments: --bogus"),
+        (("serve", "--port-base", "many"), "invalid int value: 'many'"),
+        (("demo", "--world", "/no/such/world.yaml"), "world file not found: /no/such/world.yaml"),
+    ],
+)
+def test_bad_usage_exits_non_zero_with_one_line(arguments: tuple[str, ...], reason: str) -> None:
+    done = run_cli(*arguments)
+    assert done.returncode == 2
+    assert done.stdout == ""
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("sila-labware"), done.stderr
+    assert reason in lines[0]
+
+
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    return True
+
+
+@pytest.mark.parametrize("stop_signal", [signal.SIGINT, signal.SIGTERM])
+def test_serve_prints_servers_and_stops_everything_quickly(
+    tmp_path: Path, stop_signal: signal.Signals
+) -> None:
+    port_base = free_port_base(4)
+    ca_file = tmp_path / "ca.pem"
+    serve = subprocess.Popen(
+        [*CLI, "serve", "--port-base", str(port_base), "--ca-file", str(ca_file), "--no-discovery"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        lines: list[str] = []
+        assert serve.stdout is not None
+        while not lines or lines[-1] != "serving; Ctrl-C stops":
+            line = serve.stdout.readline()
+            assert line, f"serve ended early: {serve.wait(5)} {serve.stderr.read() if serve.stderr else ''}"
+            lines.append(line.rstrip("\n"))
+        output = "\n".join(lines)
+        assert f"127.0.0.1:{port_base}" in output and "TIAGo Labware Robot" in output
+        assert "Station station_a" in output and "Station station_b" in output
+        assert f"CA file for clients: {ca_file.resolve()}" in output
+        child_pids = [int(pid) for pid in re.findall(r"robot side: \w+ pid (\d+)", output)]
+        assert len(child_pids) == 2
+
+        client = SilaClient("127.0.0.1", port_base, root_certs=ca_file.read_bytes())
+        assert client.SiLAService.ServerName.get() == "TIAGo Labware Robot"
+
+        started = time.monotonic()
+        serve.send_signal(stop_signal)
+        assert serve.wait(timeout=10) == 0
+        assert time.monotonic() - started < 5.0
+        assert not any(_pid_alive(pid) for pid in child_pids)
+    finally:
+        if serve.poll() is None:
+            serve.kill()
+            serve.wait()
+
+
+def test_demo_json_reports_the_transfer_and_records_pictures(tmp_path: Path) -> None:
+    record_dir = tmp_path / "record"
+    done = run_cli(
+        "demo",
+        "--json",
+        "--record",
+        str(record_dir),
+        "--insecure",
+        "--no-discovery",
+        "--port-base",
+        str(free_port_base(4)),
+        "--log-dir",
+        str(tmp_path / "logs"),
+        timeout_s=600,
+    )
+    report = json.loads(done.stdout)
+    assert set(report) >= {
+        "success",
+        "plate_position_error_mm",
+        "plate_yaw_error_deg",
+        "sim_seconds",
+        "wall_seconds",
+        "steps",
+    }
+    assert len(report["steps"]) == 6
+    assert all(set(step) == {"name", "sim_seconds", "wall_seconds"} for step in report["steps"])
+    assert report["success"] is True, report
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "without encryption" in done.stderr.lower()
+    assert_run_pictures(record_dir)
+
+
+def assert_run_pictures(record_dir: Path) -> None:
+    """`demo --record DIR`: an image strip, a GIF, and head-camera frames with the marker outlined."""
+    strip = cv2.imread(str(record_dir / "run_strip.png"))
+    assert strip is not None and strip.shape[0] >= 480 and strip.std() > 10
+    assert (record_dir / "run.gif").stat().st_size > 1000
+    head_frames = sorted((record_dir / "frames").glob("head_*.png"))
+    assert len(head_frames) >= 2  # one sighting at each station
+    # the outline drawn around the detected marker is the detector's colour (255, 200, 0) in RGB
+    outlined = cv2.cvtColor(cv2.imread(str(head_frames[0])), cv2.COLOR_BGR2RGB)
+    assert (np.abs(outlined.astype(int) - (255, 200, 0)).sum(axis=2) < 30).sum() > 20

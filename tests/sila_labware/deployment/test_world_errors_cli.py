@@ -1,0 +1,69 @@
+"""`sila-labware serve/demo --world bad.yaml`: a non-zero exit and ONE line naming the file, the
+field and what is wrong - the message a lab technician editing the world file needs, shown by the
+real CLI, which learns it from the real simulation node that refused the file."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import pytest
+import yaml
+
+from tests.helpers.sila_stack import DEFAULT_WORLD, free_port_base
+
+CLI = [sys.executable, "-m", "sila_labware.deployment.cli"]
+
+
+def bad_world(tmp_path: Path, mutate: Callable[[dict[str, Any]], None]) -> Path:
+    world = yaml.safe_load(DEFAULT_WORLD.read_text())
+    mutate(world)
+    path = tmp_path / "bad_world.yaml"
+    path.write_text(yaml.safe_dump(world))
+    return path
+
+
+def run_with_world(command: str, world: Path) -> subprocess.CompletedProcess:
+    arguments = [command, "--world", str(world), "--no-discovery", "--port-base", str(free_port_base(4))]
+    return subprocess.run(
+        [*CLI, *arguments], capture_output=True, text=True, timeout=120, stdin=subprocess.DEVNULL
+    )
+
+
+def only_line(stderr: str) -> str:
+    lines = stderr.strip().splitlines()
+    assert len(lines) == 1, stderr
+    return lines[0]
+
+
+@pytest.mark.parametrize(
+    ("mutate", "field", "problem"),
+    [
+        (lambda w: w["stations"][1]["marker"].update(id=17), "stations[1].marker.id", "mirrored"),
+        (lambda w: w["stations"][0]["table"].pop("pose"), "stations[0].table.pose", "missing"),
+        (lambda w: w["plates"][0].update(station="nowhere"), "plates[0].station", "unknown station"),
+    ],
+)
+def test_serve_refuses_an_invalid_world_in_one_line(
+    tmp_path: Path, mutate: Callable[[dict[str, Any]], None], field: str, problem: str
+) -> None:
+    world = bad_world(tmp_path, mutate)
+    done = run_with_world("serve", world)
+    assert done.returncode != 0
+    line = only_line(done.stderr)
+    assert line.startswith("sila-labware: could not start:"), line
+    assert str(world) in line and field in line and problem in line, line
+    assert "serving" not in done.stdout
+
+
+def test_demo_refuses_unparsable_yaml_in_one_line(tmp_path: Path) -> None:
+    world = tmp_path / "broken.yaml"
+    world.write_text("stations: [unclosed\n  - name: station_a\n")
+    done = run_with_world("demo", world)
+    assert done.returncode != 0
+    line = only_line(done.stderr)
+    assert str(world) in line and "not valid YAML" in line, line
+    assert done.stdout == ""

@@ -1,0 +1,43 @@
+"""RobotController against a real rclpy peer in another process: step timeouts cancel the ROS goal,
+refusals come before any goal is sent."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+
+from ros_bridge.robot_link import RobotLink
+from ros_bridge.workcell import StationDescription, WorkcellDescription
+from sila_labware.device.robot_controller import MotionFailed, RobotController
+
+WORKCELL = WorkcellDescription(
+    stations=(StationDescription("reader", 1, "reader_poi"),),
+    hotel_slots=2,
+    pois=("reader_poi", "rack_poi"),
+    dock_poi="dock_approach",
+)
+
+
+def test_a_step_past_its_timeout_is_cancelled_and_reported(link: RobotLink) -> None:
+    controller = RobotController(link, WORKCELL, step_timeout_s=0.5)
+    reports: list[float] = []
+    started = time.monotonic()
+    with pytest.raises(MotionFailed) as caught:
+        controller.drive_to_poi("rack_poi", report=lambda progress, _remaining: reports.append(progress))
+    assert caught.value.error_code == "CANCELED"
+    assert "cancelled after" in caught.value.message
+    assert time.monotonic() - started < 3.0, "the goal must be cancelled, not waited out"
+    assert reports and all(0.0 <= value < 0.5 for value in reports)
+    assert controller.sequence.phase.value == "idle"
+
+
+def test_refusals_send_no_goal(link: RobotLink) -> None:
+    controller = RobotController(link, WORKCELL)
+    with pytest.raises(MotionFailed, match="no point of interest 'attic'") as caught:
+        controller.drive_to_poi("attic")
+    assert caught.value.error_code == "UNKNOWN_POI"
+    before = link.robot_status(5.0).detail
+    assert controller.stop_motion() is False  # nothing runs
+    time.sleep(0.3)
+    assert link.robot_status().detail == before  # the peer finished no goal meanwhile

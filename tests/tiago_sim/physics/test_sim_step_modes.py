@@ -1,0 +1,72 @@
+"""Adaptive physics step: long steps in free motion, the notes' 1/240 s wherever a plate is handled.
+
+Why a test: the long step is where the simulation wins its speed, and it must never reach the
+grasp; a plate resting in the hotel pocket rides a drive clamped, at long steps, without slipping,
+and the clamp lets go once the base stands.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pybullet as p
+
+from tests.helpers.sim_steps import step_lengths
+from tiago_sim import transforms as tf
+from tiago_sim.lab.world import load_world
+from tiago_sim.physics.simulation import FREE_MOTION_STEP_RATIO, Simulation
+
+PLATE = "plate_001"
+
+
+def _put_plate_in_hotel(sim: Simulation, slot: int) -> None:
+    height = sim.scene.plate_types[PLATE].height
+    T_world_plate = sim.robot.link_pose(f"hotel_slot_{slot}") @ tf.make_transform((0, 0, height / 2 + 0.001))
+    position, quat = tf.to_pose(T_world_plate)
+    p.resetBasePositionAndOrientation(
+        sim.scene.plates[PLATE], position.tolist(), quat.tolist(), physicsClientId=sim.client_id
+    )
+    for _ in range(120):
+        sim.step()
+
+
+def _plate_in_base(sim: Simulation) -> np.ndarray:
+    return tf.invert(sim.robot.base_pose()) @ sim._plate_bottom(PLATE)
+
+
+def test_driving_takes_long_steps_and_a_gripper_motion_short_ones():
+    sim = Simulation(load_world(), seed=4)
+    try:
+        long_step = sim.time_step * FREE_MOTION_STEP_RATIO
+        assert set(step_lengths(sim, sim.undock())) == {long_step}
+        closing = step_lengths(sim, sim.gripper("right", close=True))
+        assert closing and set(closing) == {sim.time_step}
+    finally:
+        sim.close()
+
+
+def test_plate_in_the_hotel_rides_a_drive_clamped_at_long_steps_without_slipping():
+    world = load_world()
+    sim = Simulation(world, seed=6)
+    try:
+        _put_plate_in_hotel(sim, 1)
+        assert sim.hotel_occupancy()[0][1] == PLATE
+        before = _plate_in_base(sim)
+        long_step = sim.time_step * FREE_MOTION_STEP_RATIO
+        assert set(step_lengths(sim, sim.undock())) == {long_step}
+        lab = world.pois["lab_centre"]
+        drive = sim.drive_to(lab.x, lab.y, lab.yaw)
+        sim.step()
+        assert sim.hotel_clamp.closed
+        assert set(step_lengths(sim, drive)) == {long_step}  # turns too
+        while sim.hotel_clamp.closed:  # it opens once the base stands
+            sim.step()
+            assert sim.sim_time < 120.0
+        assert sim.base.stopped()
+        for _ in range(60):
+            sim.step()
+        after = _plate_in_base(sim)
+        assert np.linalg.norm(after[:3, 3] - before[:3, 3]) < 0.001
+        assert abs(tf.wrap_angle(tf.yaw_of(tf.invert(before) @ after))) < np.radians(0.2)
+        assert sim.hotel_occupancy()[0][1] == PLATE
+    finally:
+        sim.close()

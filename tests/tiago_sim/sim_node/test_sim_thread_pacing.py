@@ -1,0 +1,35 @@
+"""The idle robot's clock runs at the wall clock's pace, however many jobs the robot software sends.
+
+Why a test: simulated time is what the benchmarks and the campaign report as robot time. A job
+(a snapshot, a render, an IK solve) must cost the idle robot the wall time it takes, not an extra
+physics step each (that added about 1 s of simulated time to every transfer).
+"""
+
+from __future__ import annotations
+
+import time
+
+from tiago_sim.lab.world import load_world
+from tiago_sim.physics.simulation import Simulation
+from tiago_sim.sim_node.sim_thread import SimThread
+
+
+def test_an_idle_clock_follows_the_wall_clock_through_a_burst_of_jobs():
+    thread = SimThread(lambda: Simulation(load_world(), seed=1), idle_realtime_factor=1.0)
+    thread.start()
+    try:
+        time.sleep(0.3)  # paced from here
+        sim_before = thread.run(lambda sim: sim.sim_time)
+        wall_before = time.monotonic()
+        time.sleep(0.5)
+        sim_paced = thread.run(lambda sim: sim.sim_time)
+        wall_paced = time.monotonic()
+        assert abs((sim_paced - sim_before) - (wall_paced - wall_before)) < 0.1
+        for _ in range(200):  # one after the other: each wakes the thread on its own
+            thread.run(lambda sim: sim.sim_time)
+        sim_after = thread.run(lambda sim: sim.sim_time)
+        wall_s = time.monotonic() - wall_paced
+        step_s = 1 / 60  # the longest physics step
+        assert sim_after - sim_paced <= wall_s + 2 * step_s, (sim_after - sim_paced, wall_s)
+    finally:
+        thread.stop()

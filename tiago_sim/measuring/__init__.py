@@ -1,0 +1,1 @@
+"""Measuring tools: seeded disturbances, fault injection, the run recorder, the ROS benchmark."""

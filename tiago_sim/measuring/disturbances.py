@@ -1,0 +1,247 @@
+"""Seeded disturbances for repeatability campaigns: the failure sources field reports name.
+
+Why: the published TIAGo++ and mobile-manipulator transfer studies lost runs to navigation drift on
+uneven floors and to placements off by millimetres. A campaign must show our success rate under
+the same kinds of error, drawn afresh per trial but reproducible from one seed.
+
+Model: two worlds come out of one nominal world. The *true* world (what PyBullet builds) has its
+stations moved on the floor, each marker glued slightly off its nominal place on the stand, and
+each nest row mounted slightly off; the nests stay put when only the marker moves, so the
+robot's calibrated site-in-marker transform is wrong by exactly the marker error. The *believed*
+world (what the robot's behaviours read: POIs, marker ids, site-in-marker) is the nominal one,
+except that every station POI is shifted: the base stops off the pose the station expects, as
+it does after a real navigation with localisation error. Odometry drift (wheel radius error plus
+per-step slip), Gaussian camera noise and plate mass/friction spread act inside the Simulation.
+
+Levels are standard deviations (SI: m, rad; camera noise in 8-bit grey levels; spreads relative);
+every draw is clipped at 3 sigma so a rare draw stays a physically plausible one.
+Pure functions except ``apply_to_simulation`` (sim thread: it touches the PyBullet client).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import logging
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from tiago_sim import transforms as tf
+from tiago_sim.lab.world import Pose2D, Station, World
+
+log = logging.getLogger(__name__)
+
+CLIP_SIGMAS = 3.0
+
+
+@dataclass(frozen=True)
+class DisturbanceLevels:
+    """One standard deviation per failure source; defaults are the campaign's default level.
+
+    Rationale for the defaults:
+    - navigation 3 cm / 2 deg: AMCL-style localisation on a lab floor ends within a few cm and
+      degrees of the goal (the TIAGo++ study's main failure source, worse on uneven floors).
+    - odometry 0.2 %: wheel radius error and slip per wheel; tiles and thresholds make it
+      several times the factory 0.05 %.
+    - station 1 cm / 1 deg: a bench nudged since the map was drawn.
+    - marker 1 mm / 0.5 deg: a marker stuck on by hand against a printed template.
+    - nest 1 mm / 0.3 deg: nests screwed down with slotted holes (the "off by millimetres" case).
+    - camera 2 grey levels: read noise of a consumer RGB-D camera in lab light.
+    - plate mass 10 %, friction 15 %: filled versus empty plates, different polystyrene batches.
+    """
+
+    navigation_xy_m: float = 0.03
+    navigation_yaw_rad: float = math.radians(2.0)
+    odometry_noise: float = 0.002
+    station_xy_m: float = 0.01
+    station_yaw_rad: float = math.radians(1.0)
+    marker_xy_m: float = 0.001
+    marker_yaw_rad: float = math.radians(0.5)
+    nest_xy_m: float = 0.001
+    nest_yaw_rad: float = math.radians(0.3)
+    camera_noise: float = 2.0
+    plate_mass_spread: float = 0.10
+    plate_friction_spread: float = 0.15
+
+    def scaled(self, factor: float) -> DisturbanceLevels:
+        """Every level times `factor` (0 gives an undisturbed world)."""
+        return DisturbanceLevels(**{k: v * factor for k, v in dataclasses.asdict(self).items()})
+
+    def to_json(self) -> str:
+        return json.dumps(dataclasses.asdict(self), sort_keys=True)
+
+    @classmethod
+    def from_json(cls, text: str) -> DisturbanceLevels:
+        values = json.loads(text)
+        unknown = set(values) - {f.name for f in dataclasses.fields(cls)}
+        if unknown:
+            raise ValueError(f"unknown disturbance levels: {sorted(unknown)}")
+        return cls(**{k: float(v) for k, v in values.items()})
+
+
+@dataclass(frozen=True)
+class PlanarOffset:
+    """A small rigid error in a plane: x, y (m) and rotation about the plane's normal (rad)."""
+
+    x: float = 0.0
+    y: float = 0.0
+    yaw: float = 0.0
+
+    def matrix(self) -> np.ndarray:
+        return tf.from_planar(self.x, self.y, self.yaw)
+
+    def human(self) -> dict[str, float]:
+        """mm and degrees, rounded, for logs and reports."""
+        return {
+            "x_mm": round(1000 * self.x, 2),
+            "y_mm": round(1000 * self.y, 2),
+            "yaw_deg": round(math.degrees(self.yaw), 3),
+        }
+
+
+@dataclass(frozen=True)
+class TrialDisturbance:
+    """The concrete draws of one trial (all from `seed`)."""
+
+    seed: int
+    levels: DisturbanceLevels
+    navigation: dict[str, PlanarOffset] = field(default_factory=dict)  # POI name -> base stop error
+    station: dict[str, PlanarOffset] = field(default_factory=dict)  # table pose error (floor plane)
+    marker: dict[str, PlanarOffset] = field(default_factory=dict)  # in the marker plane
+    nest: dict[str, PlanarOffset] = field(default_factory=dict)  # nest row, in the site plane
+    plate_mass_factor: dict[str, float] = field(default_factory=dict)
+    plate_friction_factor: dict[str, float] = field(default_factory=dict)
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-ready description in mm/deg (what a failure log shows next to the seed)."""
+
+        def offsets(table: dict[str, PlanarOffset]) -> dict[str, dict[str, float]]:
+            return {name: offset.human() for name, offset in table.items()}
+
+        return {
+            "seed": self.seed,
+            "navigation": offsets(self.navigation),
+            "station": offsets(self.station),
+            "marker": offsets(self.marker),
+            "nest": offsets(self.nest),
+            "plate_mass_factor": {k: round(v, 3) for k, v in self.plate_mass_factor.items()},
+            "plate_friction_factor": {k: round(v, 3) for k, v in self.plate_friction_factor.items()},
+        }
+
+
+def _clipped_normal(rng: np.random.Generator, sigma: float) -> float:
+    if sigma <= 0.0:
+        rng.standard_normal()  # keep the stream aligned whatever the levels
+        return 0.0
+    return float(np.clip(rng.standard_normal(), -CLIP_SIGMAS, CLIP_SIGMAS) * sigma)
+
+
+def _offset(rng: np.random.Generator, xy_sigma: float, yaw_sigma: float) -> PlanarOffset:
+    return PlanarOffset(
+        _clipped_normal(rng, xy_sigma), _clipped_normal(rng, xy_sigma), _clipped_normal(rng, yaw_sigma)
+    )
+
+
+def draw(world: World, seed: int, levels: DisturbanceLevels) -> TrialDisturbance:
+    """All draws of one trial, in a fixed order (stations, then plates, as the world lists them)."""
+    rng = np.random.default_rng(seed)
+    navigation, station, marker, nest = {}, {}, {}, {}
+    for s in world.stations:
+        navigation[s.poi] = _offset(rng, levels.navigation_xy_m, levels.navigation_yaw_rad)
+        station[s.name] = _offset(rng, levels.station_xy_m, levels.station_yaw_rad)
+        marker[s.name] = _offset(rng, levels.marker_xy_m, levels.marker_yaw_rad)
+        nest[s.name] = _offset(rng, levels.nest_xy_m, levels.nest_yaw_rad)
+    mass, friction = {}, {}
+    for plate in world.plates:
+        mass[plate.labware_id] = 1.0 + _clipped_normal(rng, levels.plate_mass_spread)
+        friction[plate.labware_id] = 1.0 + _clipped_normal(rng, levels.plate_friction_spread)
+    return TrialDisturbance(seed, levels, navigation, station, marker, nest, mass, friction)
+
+
+def _xyz_rpy(transform: np.ndarray) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """Inverse of tf.from_xyz_rpy (R = Rz Ry Rx); pitch stays away from +-90 deg for our frames."""
+    rotation = transform[:3, :3]
+    pitch = math.asin(-max(-1.0, min(1.0, rotation[2, 0])))
+    roll = math.atan2(rotation[2, 1], rotation[2, 2])
+    yaw = math.atan2(rotation[1, 0], rotation[0, 0])
+    x, y, z = (float(v) for v in transform[:3, 3])
+    return (x, y, z), (roll, pitch, yaw)
+
+
+def _true_station(station: Station, disturbance: TrialDisturbance) -> Station:
+    moved, marker_error, nest_error = (
+        disturbance.station[station.name],
+        disturbance.marker[station.name],
+        disturbance.nest[station.name],
+    )
+    table = station.table_pose
+    c, s = math.cos(table.yaw), math.sin(table.yaw)
+    table_pose = Pose2D(
+        table.x + c * moved.x - s * moved.y, table.y + s * moved.x + c * moved.y, table.yaw + moved.yaw
+    )
+    T_table_marker = station.T_table_marker() @ marker_error.matrix()
+    # nests stay on the table when only the marker is off; then the row itself is off by nest_error
+    T_marker_site = tf.invert(marker_error.matrix()) @ station.T_marker_site(1) @ nest_error.matrix()
+    marker_xyz, marker_rpy = _xyz_rpy(T_table_marker)
+    site_xyz, site_rpy = _xyz_rpy(T_marker_site)
+    return dataclasses.replace(
+        station,
+        table_pose=table_pose,
+        marker_xyz=marker_xyz,
+        marker_rpy=marker_rpy,
+        site_xyz=site_xyz,
+        site_rpy=site_rpy,
+    )
+
+
+def true_world(world: World, disturbance: TrialDisturbance) -> World:
+    """The world PyBullet builds: stations, markers and nests where they really are."""
+    stations = tuple(_true_station(station, disturbance) for station in world.stations)
+    return dataclasses.replace(world, stations=stations)
+
+
+def believed_world(world: World, disturbance: TrialDisturbance) -> World:
+    """The world the robot's behaviours read: nominal, but each station POI is where the base stops."""
+    pois = dict(world.pois)
+    for name, error in disturbance.navigation.items():
+        pose = pois[name]
+        c, s = math.cos(pose.yaw), math.sin(pose.yaw)
+        pois[name] = Pose2D(
+            pose.x + c * error.x - s * error.y, pose.y + s * error.x + c * error.y, pose.yaw + error.yaw
+        )
+    return dataclasses.replace(world, pois=pois)
+
+
+def noisy_camera(
+    render: Callable[..., tuple[np.ndarray, np.ndarray, Any]], sigma_levels: float, seed: int
+) -> Callable[..., tuple[np.ndarray, np.ndarray, Any]]:
+    """Wrap a head-camera render function: Gaussian read noise on the colour image (seeded)."""
+    rng = np.random.default_rng([seed, 0xCA])
+
+    def render_with_noise(*args: Any, **kwargs: Any) -> tuple[np.ndarray, np.ndarray, Any]:
+        rgb, depth, intrinsics = render(*args, **kwargs)
+        if sigma_levels > 0.0:
+            noise = rng.normal(0.0, sigma_levels, size=rgb.shape)
+            rgb = np.clip(rgb.astype(np.float32) + noise, 0, 255).astype(np.uint8)
+        return rgb, depth, intrinsics
+
+    return render_with_noise
+
+
+def apply_to_simulation(sim: Any, disturbance: TrialDisturbance) -> None:
+    """Plate mass/friction spread and camera noise on a built Simulation (sim thread)."""
+    import pybullet as p  # only the sim process needs PyBullet
+
+    for labware_id, body in sim.scene.plates.items():
+        mass = sim.scene.plate_types[labware_id].mass * disturbance.plate_mass_factor.get(labware_id, 1.0)
+        friction = p.getDynamicsInfo(body, -1, physicsClientId=sim.client_id)[1]
+        friction *= disturbance.plate_friction_factor.get(labware_id, 1.0)
+        p.changeDynamics(body, -1, mass=mass, lateralFriction=friction, physicsClientId=sim.client_id)
+    sim.render_head_camera = noisy_camera(
+        sim.render_head_camera, disturbance.levels.camera_noise, disturbance.seed
+    )
+    log.info("disturbances applied: %s", json.dumps(disturbance.summary()))

@@ -1,0 +1,206 @@
+"""Differential-drive base: velocity actuator with TIAGo's limits, wheel odometry, drive motions.
+
+Why this shape: the base is kinematic in the plane (a constraint follows the integrated,
+speed- and acceleration-limited body velocity), which is stable in PyBullet and honours the
+real drive's limits. The wheel encoders see the base's real motion with a seeded scale error and
+noise per wheel, so odometry drifts like a real robot's; drive motions close the loop on
+odometry only. Lives on the sim thread.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from tiago_sim.physics.motion import CANCELED, Motion
+from tiago_sim.physics.robot_body import RobotBody
+from tiago_sim.robot import robot_model as rm
+
+POSITION_TOLERANCE = 0.01  # m
+YAW_TOLERANCE = 0.01  # rad
+HEADING_GAIN = 2.5
+BLEND_ANGLE = 0.3  # rad: the drive starts once the heading is this close; the heading loop finishes the turn
+
+
+def wrap_angle(angle: float) -> float:
+    """Angle wrapped to (-pi, pi] (scalar, fast: called every step)."""
+    return math.atan2(math.sin(angle), math.cos(angle))
+
+
+def _ramp(current: float, desired: float, max_change: float) -> float:
+    return current + min(max(desired - current, -max_change), max_change)
+
+
+def _speed_for_distance(distance: float, accel: float, max_speed: float) -> float:
+    """Largest speed from which the remaining distance suffices to stop."""
+    return min(max_speed, math.sqrt(2.0 * accel * max(distance, 0.0)))
+
+
+class DiffDriveBase:
+    """Body-velocity actuator plus wheel odometry."""
+
+    def __init__(
+        self, body: RobotBody, x: float, y: float, yaw: float, odometry_noise: float, rng: np.random.Generator
+    ) -> None:
+        self.body = body
+        self.target = [x, y, yaw]  # pose the base constraint pulls towards
+        self.v = 0.0
+        self.w = 0.0
+        self.v_cmd = 0.0
+        self.w_cmd = 0.0
+        self.odom = [x, y, yaw]
+        self.last_true = (x, y, yaw)
+        self.idle_steps = 0
+        self.noise = odometry_noise
+        self.rng = rng
+        # per-wheel radius errors (calibration), drawn once: the systematic part of odometry drift
+        self.wheel_scale = 1.0 + odometry_noise * rng.standard_normal(2)
+
+    def command(self, v: float, w: float) -> None:
+        self.v_cmd = min(max(v, -rm.MAX_LINEAR_SPEED), rm.MAX_LINEAR_SPEED)
+        self.w_cmd = min(max(w, -rm.MAX_ANGULAR_SPEED), rm.MAX_ANGULAR_SPEED)
+
+    def stopped(self) -> bool:
+        """The command has ramped to zero and the base itself stands still (it lags the command,
+        so a drive that reports "stopped" on the command alone would still be rolling)."""
+        if abs(self.v) >= 1e-3 or abs(self.w) >= 1e-3:
+            return False
+        forward, turn = self.body.base_twist()
+        return abs(forward) < 0.005 and abs(turn) < 0.01
+
+    def update(self, dt: float) -> None:
+        """Before the physics step: accelerate towards the command and move the constraint pivot."""
+        self.v = _ramp(self.v, self.v_cmd, rm.MAX_LINEAR_ACCEL * dt)
+        self.w = _ramp(self.w, self.w_cmd, rm.MAX_ANGULAR_ACCEL * dt)
+        x, y, yaw = self.target
+        mid_yaw = yaw + 0.5 * self.w * dt
+        self.target = [
+            x + self.v * math.cos(mid_yaw) * dt,
+            y + self.v * math.sin(mid_yaw) * dt,
+            yaw + self.w * dt,
+        ]
+        if self.v != 0.0 or self.w != 0.0:
+            self.body.set_base_target(*self.target)
+
+    def integrate_odometry(self, dt: float) -> None:
+        """After the physics step: wheel encoders count the base's real displacement, with error."""
+        moving = self.v != 0.0 or self.w != 0.0 or self.v_cmd != 0.0 or self.w_cmd != 0.0
+        self.idle_steps = 0 if moving else self.idle_steps + 1
+        if self.idle_steps > 240:  # stood still for a second: the encoders read nothing, skip the work
+            return
+        x, y, yaw = self.body.base_xy_yaw()
+        last_x, last_y, last_yaw = self.last_true
+        self.last_true = (x, y, yaw)
+        heading = last_yaw + 0.5 * wrap_angle(yaw - last_yaw)
+        forward = (x - last_x) * math.cos(heading) + (y - last_y) * math.sin(heading)
+        turn = wrap_angle(yaw - last_yaw)
+        half = rm.WHEEL_SEPARATION / 2
+        wheel_left = forward - turn * half  # wheel travel in m this step
+        wheel_right = forward + turn * half
+        if self.noise > 0.0 and (abs(wheel_left) + abs(wheel_right)) > 1e-7:
+            jitter_left, jitter_right = self.rng.standard_normal(2).tolist()
+            wheel_left *= self.wheel_scale[0] * (1.0 + self.noise * jitter_left)
+            wheel_right *= self.wheel_scale[1] * (1.0 + self.noise * jitter_right)
+        distance = (wheel_left + wheel_right) / 2
+        rotation = (wheel_right - wheel_left) / rm.WHEEL_SEPARATION
+        ox, oy, oyaw = self.odom
+        mid_yaw = oyaw + 0.5 * rotation
+        self.odom = [
+            ox + distance * math.cos(mid_yaw),
+            oy + distance * math.sin(mid_yaw),
+            wrap_angle(oyaw + rotation),
+        ]
+
+
+class DriveMotion(Motion):
+    """Turn towards the goal, drive, then turn to the goal heading; closed loop on odometry.
+
+    ``reverse`` drives backwards (for docking); ``stop_when`` ends the drive early with success
+    (e.g. the dock contact closes).
+    """
+
+    def __init__(
+        self,
+        base: DiffDriveBase,
+        x: float,
+        y: float,
+        yaw: float,
+        *,
+        reverse: bool = False,
+        speed: float = rm.MAX_LINEAR_SPEED,
+        stop_when=None,
+        name: str = "drive",
+    ) -> None:
+        super().__init__(name, frozenset({"base"}))
+        self.base = base
+        self.goal = (x, y, yaw)
+        self.reverse = reverse
+        self.speed = speed
+        self.stop_when = stop_when
+        self.phase = "turning"
+        self.start_distance = max(self._distance(), 1e-6)
+
+    def _distance(self) -> float:
+        x, y, _ = self.base.odom
+        return math.hypot(self.goal[0] - x, self.goal[1] - y)
+
+    def _heading_error(self) -> float:
+        x, y, yaw = self.base.odom
+        bearing = math.atan2(self.goal[1] - y, self.goal[0] - x)
+        if self.reverse:
+            bearing += math.pi
+        return wrap_angle(bearing - yaw)
+
+    def _turn_rate(self, error: float) -> float:
+        return math.copysign(
+            _speed_for_distance(abs(error), rm.MAX_ANGULAR_ACCEL * 0.8, rm.MAX_ANGULAR_SPEED), error
+        )
+
+    def tick(self, dt: float) -> None:
+        base = self.base
+        if self.cancel_requested:
+            base.command(0.0, 0.0)
+            self.phase = "stopping"
+            if base.stopped():
+                self.finish(False, CANCELED, "canceled")
+            return
+        if self.stop_when is not None and self.stop_when():
+            base.command(0.0, 0.0)
+            if base.stopped():
+                self.finish(True, message="contact")
+            return
+        distance = self._distance()
+        self.progress = float(np.clip(1.0 - distance / self.start_distance, 0.0, 0.99))
+        self.remaining_s = distance / max(self.speed, 1e-3) + 1.0
+        if self.phase == "turning":
+            error = self._heading_error() if distance > POSITION_TOLERANCE * 2 else 0.0
+            base.command(0.0, self._turn_rate(error))
+            if distance > POSITION_TOLERANCE * 2 and abs(error) < BLEND_ANGLE:
+                self.phase = "driving"  # v ramps up from rest while the heading loop closes the error
+            elif abs(error) < 0.02 and abs(base.w) < 0.05:
+                self.phase = "aligning"
+        elif self.phase == "driving":
+            direction = -1.0 if self.reverse else 1.0
+            heading_error = self._heading_error()
+            along = distance * math.cos(heading_error)
+            v = direction * _speed_for_distance(along, rm.MAX_LINEAR_ACCEL * 0.8, self.speed)
+            if along < POSITION_TOLERANCE * 0.5 or distance < POSITION_TOLERANCE * 0.5:
+                v = 0.0
+                if base.stopped() or abs(base.v) < 0.02:
+                    self.phase = "aligning"
+            w = HEADING_GAIN * heading_error if distance > 0.05 else 0.0
+            base.command(v, w)
+        else:  # aligning
+            error = wrap_angle(self.goal[2] - base.odom[2])
+            within = abs(error) < YAW_TOLERANCE * 0.5
+            base.command(0.0, 0.0 if within else self._turn_rate(error))
+            if within and base.stopped():
+                if self.stop_when is not None:
+                    self.finish(False, "NAVIGATION_FAILED", "reached the end of the path without contact")
+                else:
+                    self.finish(True)
+
+    def finish(self, success: bool, error_code: str = "", message: str = "") -> None:
+        self.base.command(0.0, 0.0)
+        super().finish(success, error_code, message)

@@ -1,0 +1,146 @@
+"""Parallel gripper: force-capped position control, geared fingers, grasp check and travel attach.
+
+Why: a microplate must be held by friction (16 N per finger, pads and plate at friction 1.0, as
+measured in the notes). Only after both pads touch the same plate does a fixed constraint
+"attach" it for travel; the constraint goes before the fingers open. Lives on the sim thread.
+"""
+
+from __future__ import annotations
+
+import pybullet as p
+
+from tiago_sim.physics.motion import CANCELED, Motion
+from tiago_sim.physics.robot_body import RobotBody
+from tiago_sim.robot import robot_model as rm
+
+PAD_FRICTION = 1.0
+PAD_SPINNING_FRICTION = 0.02
+STALL_SPEED = 0.002  # m/s: fingers count as stopped below this
+STALL_TIME_S = 0.15
+ATTACH_FORCE = 60.0  # N
+HOLDER_FRICTION = 0.15  # the hotel's polished lead-ins, as the station nests' (see scene.NEST_FRICTION)
+GEAR_FORCE = 5.0  # N: keeps the fingers in step in free motion, yields so both pads reach an off-centre plate
+
+
+class Gripper:
+    """One gripper's fingers, its grasp sensing and the travel attach constraint."""
+
+    def __init__(self, body: RobotBody, side: str, plate_bodies: dict[str, int]) -> None:
+        self.body = body
+        self.side = side
+        self.plate_bodies = plate_bodies
+        self.fingers = rm.finger_joint_names(side)
+        self.finger_links = [body.link_index[f"gripper_{side}_{f}_finger_link"] for f in ("left", "right")]
+        self.palm_link, _ = body.frame_on_link(f"gripper_{side}_link")
+        self.attach_constraint: int | None = None
+        self.attached_id = ""
+        client = body.client
+        for link in self.finger_links:
+            p.changeDynamics(
+                body.id,
+                link,
+                lateralFriction=PAD_FRICTION,
+                spinningFriction=PAD_SPINNING_FRICTION,
+                physicsClientId=client,
+            )
+        # The hotel tray is merged into the base body (-1). At the default 0.5 a plate released 4 mm
+        # off centre stayed on a lead-in chamfer (3 to 5 mm up); at 0.15 it slides into the pocket.
+        p.changeDynamics(body.id, -1, lateralFriction=HOLDER_FRICTION, physicsClientId=client)
+        left, right = (body.joint_index[n] for n in self.fingers)
+        gear = p.createConstraint(
+            body.id,
+            left,
+            body.id,
+            right,
+            p.JOINT_GEAR,
+            [0, 1, 0],
+            [0, 0, 0],
+            [0, 0, 0],
+            physicsClientId=client,
+        )
+        p.changeConstraint(gear, gearRatio=-1, maxForce=GEAR_FORCE, erp=0.2, physicsClientId=client)
+        self.command(rm.FINGER_TRAVEL)
+
+    def command(self, finger_position: float) -> None:
+        self.body.command_positions({name: finger_position for name in self.fingers})
+
+    def opening(self) -> float:
+        """Gap between the pads in m."""
+        joints = self.body.joint_positions()
+        return 2 * rm.FINGER_MOUNT_OFFSET + sum(joints[n] for n in self.fingers)
+
+    def touching(self) -> str:
+        """Labware id that both pads touch, or ""."""
+        client = self.body.client
+        for labware_id, plate in self.plate_bodies.items():
+            if all(
+                p.getContactPoints(self.body.id, plate, link, -1, physicsClientId=client)
+                for link in self.finger_links
+            ):
+                return labware_id
+        return ""
+
+    def attach(self, labware_id: str) -> None:
+        """Fix the plate to the palm where it is now (only after a verified friction grasp)."""
+        plate = self.plate_bodies[labware_id]
+        self.attach_constraint = self.body.fix_to_link(self.palm_link, plate, ATTACH_FORCE)
+        self.attached_id = labware_id
+
+    def detach(self) -> None:
+        if self.attach_constraint is not None:
+            p.removeConstraint(self.attach_constraint, physicsClientId=self.body.client)
+        self.attach_constraint = None
+        self.attached_id = ""
+
+
+class GripperMotion(Motion):
+    """Open or close; when closing, ends once the fingers stall (on a plate) or close fully."""
+
+    def __init__(self, gripper: Gripper, close: bool) -> None:
+        super().__init__(
+            f"gripper_{gripper.side}_{'close' if close else 'open'}", frozenset({f"gripper_{gripper.side}"})
+        )
+        self.gripper = gripper
+        self.close = close
+        self.holding = False
+        self.opening_m = gripper.opening()
+        self.stall_s = 0.0
+        self.history: list[list[float]] = []
+        self.phase = "closing" if close else "opening"
+        if not close:
+            gripper.detach()
+        gripper.command(0.0 if close else rm.FINGER_TRAVEL)
+        self.remaining_s = rm.FINGER_TRAVEL / rm.FINGER_SPEED + 0.3
+
+    def tick(self, dt: float) -> None:
+        gripper = self.gripper
+        self.opening_m = gripper.opening()
+        if self.cancel_requested:
+            joints = gripper.body.joint_positions()
+            gripper.body.command_positions({n: joints[n] for n in gripper.fingers})
+            self.finish(False, CANCELED, "canceled")
+            return
+        target = 0.0 if self.close else rm.FINGER_TRAVEL
+        remaining = abs(sum(gripper.body.joint_positions()[n] for n in gripper.fingers) / 2 - target)
+        self.progress = float(min(0.99, 1.0 - remaining / rm.FINGER_TRAVEL))
+        self.remaining_s = remaining / rm.FINGER_SPEED + 0.2
+        # stall from the fingers' travel over the last STALL_TIME_S (reported joint velocities jitter
+        # while the gear constraint and the contacts balance)
+        positions = [gripper.body.joint_positions()[n] for n in gripper.fingers]
+        self.history.append(positions)
+        window = max(1, int(STALL_TIME_S / dt))
+        del self.history[: -window - 1]
+        travel = max(abs(a - b) for a, b in zip(self.history[0], positions, strict=True))
+        started = self.elapsed_s > 0.25  # fingers are at rest before they start to move
+        moving = len(self.history) <= window or travel > STALL_SPEED * STALL_TIME_S
+        self.stall_s = self.stall_s + dt if (started and not moving) else 0.0
+        timed_out = (
+            self.elapsed_s > rm.FINGER_TRAVEL / rm.FINGER_SPEED + 1.0
+        )  # fingers pressing but jittering
+        if remaining < 5e-4 or self.stall_s > 0.0 or timed_out:
+            if self.close:
+                labware_id = gripper.touching()
+                self.holding = bool(labware_id) and self.opening_m > 2 * rm.FINGER_MOUNT_OFFSET + 0.002
+                if self.holding:
+                    gripper.attach(labware_id)
+            self.finish(True, message="holding" if self.holding else "")

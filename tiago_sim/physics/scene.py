@@ -1,0 +1,199 @@
+"""Builds the static lab and the plates in a PyBullet client from a World.
+
+Why separate from the robot: the lab is pure world data (floor, dock, tables, nests, markers,
+plates); the Simulation adds the robot on top. Call on the thread that owns the client.
+Nests are four corner L-brackets around a pocket (plate size + clearance) with 45 deg lead-in
+chamfers of low friction, as real SBS nests have: a plate released a few millimetres or a degree
+or two off centre slides into the pocket. The brackets leave the middle of the plate's long
+sides free for the finger pads.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import pybullet as p
+
+from tiago_sim import transforms as tf
+from tiago_sim.lab.world import LabwareType, Station, World
+from tiago_sim.perception.marker_asset import marker_visual
+from tiago_sim.robot.robot_model import BASE_RADIUS
+
+log = logging.getLogger(__name__)
+
+PLATE_FRICTION = 1.0
+PLATE_SPINNING_FRICTION = 0.02
+NEST_LEAD_IN = 0.006  # per side, 45 deg from the bench top: the opening is this much wider than the pocket
+NEST_RAMP_FOOT = 0.001  # the ramp runs on this far below the bench top: no edge is left at its foot
+NEST_LEG_LENGTH = 0.015  # bracket legs run this far in from each corner
+NEST_FRICTION = 0.15  # polished lead-ins: with the plate's 1.0, the pair's friction is 0.15
+TABLE_FRICTION = 0.3  # laminate bench top: plate on table 0.3
+DOCK_GAP = 0.002  # between the docked robot's rear and the dock's contact plate
+DOCK_SIZE = (0.10, 0.45, 0.30)
+
+
+@dataclass
+class Scene:
+    """Body ids of what was built; ``plates`` maps labware id -> body id."""
+
+    floor: int = -1
+    dock: int = -1
+    tables: dict[str, int] = field(default_factory=dict)
+    nests: dict[tuple[str, int], int] = field(default_factory=dict)
+    markers: dict[str, int] = field(default_factory=dict)
+    plates: dict[str, int] = field(default_factory=dict)
+    plate_types: dict[str, LabwareType] = field(default_factory=dict)
+
+
+def _static_box(client: int, size, T_world_box: np.ndarray, rgba, collide: bool = True) -> int:
+    half = [s / 2 for s in size]
+    collision = (
+        p.createCollisionShape(p.GEOM_BOX, halfExtents=half, physicsClientId=client) if collide else -1
+    )
+    visual = p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=rgba, physicsClientId=client)
+    position, quat = tf.to_pose(T_world_box)
+    return p.createMultiBody(0.0, collision, visual, position.tolist(), quat.tolist(), physicsClientId=client)
+
+
+def nest_boxes(length: float, width: float) -> list[tuple[tuple, tuple, tuple]]:
+    """Boxes (size, centre, quaternion) of a nest: four corner L-brackets of 45 deg lead-in ramps.
+
+    Each bracket leg is a ramp rising from the pocket edge on the bench top to ``NEST_LEAD_IN``
+    outside it, so a plate released up to clearance + lead-in off centre slides into the pocket
+    (low-friction bracket material). The ramp starts at the bench top, with no vertical wall under
+    it: a wall's top corner is a ledge on which a plate's bottom rests 1 deg tilted, held by the
+    bench's friction under its other edge (campaigns 6000 and 7000 lost 1 to 1.5 % of transfers so).
+    """
+    boxes = []
+    overlap, leg, lead, foot, thick = 0.006, NEST_LEG_LENGTH, NEST_LEAD_IN, NEST_RAMP_FOOT, 0.004
+    slope = (lead + foot) * math.sqrt(2.0)
+    inset = thick / 2 / math.sqrt(2.0)  # from the ramp surface to the box's mid-plane, along x (or y) and z
+    mid = (lead - foot) / 2  # the middle of the ramp surface, outwards of the pocket edge and above the bench
+    for cx in (-1, 1):
+        for cy in (-1, 1):
+            # leg across the short end (ramp rising along x), spanning `leg` in from the corner
+            along_y = cy * (width / 2 - leg / 2 + overlap / 2)
+            quat_x = tf.matrix_to_quat(
+                tf.rpy_to_matrix(0.0, -math.pi / 4 if cx > 0 else -3 * math.pi / 4, 0.0)
+            )
+            centre_x = (cx * (length / 2 + mid + inset), along_y, mid - inset)
+            boxes.append(((slope, leg + overlap, thick), centre_x, tuple(quat_x)))
+            # leg along the long side (ramp rising along y)
+            along_x = cx * (length / 2 - leg / 2)
+            quat_y = tf.matrix_to_quat(tf.rpy_to_matrix(math.pi / 4 if cy > 0 else 3 * math.pi / 4, 0.0, 0.0))
+            centre_y = (along_x, cy * (width / 2 + mid + inset), mid - inset)
+            boxes.append(((leg, slope, thick), centre_y, tuple(quat_y)))
+    return boxes
+
+
+def _compound_static(client: int, boxes, T_world_body: np.ndarray, rgba) -> int:
+    """One static body made of several boxes given as (size, centre[, quaternion]) in the body frame."""
+    halves = [[s / 2 for s in box[0]] for box in boxes]
+    centres = [list(box[1]) for box in boxes]
+    orientations = [list(box[2]) if len(box) > 2 else [0, 0, 0, 1] for box in boxes]
+    shapes = [p.GEOM_BOX] * len(boxes)
+    collision = p.createCollisionShapeArray(
+        shapes,
+        halfExtents=halves,
+        collisionFramePositions=centres,
+        collisionFrameOrientations=orientations,
+        physicsClientId=client,
+    )
+    visual = p.createVisualShapeArray(
+        shapes,
+        halfExtents=halves,
+        visualFramePositions=centres,
+        visualFrameOrientations=orientations,
+        rgbaColors=[rgba] * len(boxes),
+        physicsClientId=client,
+    )
+    position, quat = tf.to_pose(T_world_body)
+    return p.createMultiBody(0.0, collision, visual, position.tolist(), quat.tolist(), physicsClientId=client)
+
+
+def _build_station(client: int, station: Station, labware: LabwareType, scene: Scene) -> None:
+    depth, width, height = station.table_size
+    T_world_top = station.T_world_table()
+    scene.tables[station.name] = _static_box(
+        client,
+        (depth, width, height),
+        T_world_top @ tf.make_transform((0, 0, -height / 2)),
+        [0.75, 0.7, 0.6, 1],
+    )
+    p.changeDynamics(scene.tables[station.name], -1, lateralFriction=TABLE_FRICTION, physicsClientId=client)
+    # marker on a thin board standing behind it
+    T_world_marker = station.T_world_marker()
+    board = station.marker_size * 1.4
+    stand_height = station.marker_xyz[2] + board / 2
+    T_world_board = T_world_marker @ tf.make_transform((0, stand_height / 2 - station.marker_xyz[2], -0.006))
+    _static_box(client, (board, stand_height, 0.01), T_world_board, [0.95, 0.95, 0.95, 1])
+    T_world_tile = T_world_marker @ tf.make_transform((0, 0, 0.0008))
+    scene.markers[station.name] = marker_visual(client, station.marker_id, station.marker_size, T_world_tile)
+    pocket = (labware.length + 2 * station.nest_clearance, labware.width + 2 * station.nest_clearance)
+    boxes = nest_boxes(pocket[0], pocket[1])
+    for sub in range(1, station.sub_positions + 1):
+        nest = _compound_static(client, boxes, station.T_world_site(sub), [0.25, 0.25, 0.28, 1])
+        p.changeDynamics(nest, -1, lateralFriction=NEST_FRICTION, physicsClientId=client)
+        scene.nests[(station.name, sub)] = nest
+
+
+def _plate_body(client: int, labware: LabwareType, T_world_bottom: np.ndarray) -> int:
+    half = [labware.length / 2, labware.width / 2, labware.height / 2]
+    collision = p.createCollisionShape(p.GEOM_BOX, halfExtents=half, physicsClientId=client)
+    visual = p.createVisualShape(
+        p.GEOM_BOX, halfExtents=half, rgbaColor=[0.95, 0.55, 0.15, 1], physicsClientId=client
+    )
+    T_world_centre = T_world_bottom @ tf.make_transform((0, 0, labware.height / 2 + 0.0005))
+    position, quat = tf.to_pose(T_world_centre)
+    body = p.createMultiBody(
+        labware.mass, collision, visual, position.tolist(), quat.tolist(), physicsClientId=client
+    )
+    p.changeDynamics(
+        body,
+        -1,
+        lateralFriction=PLATE_FRICTION,
+        spinningFriction=PLATE_SPINNING_FRICTION,
+        rollingFriction=0.0,
+        physicsClientId=client,
+    )
+    return body
+
+
+def plate_bottom_pose(client: int, body: int, labware: LabwareType) -> np.ndarray:
+    """T_world of the plate's bottom-centre frame (what a nest site frame should coincide with)."""
+    position, quat = p.getBasePositionAndOrientation(body, physicsClientId=client)
+    return tf.from_pose(position, quat) @ tf.make_transform((0, 0, -labware.height / 2))
+
+
+def build_scene(client: int, world: World, T_world_hotel_slots: dict[int, np.ndarray] | None = None) -> Scene:
+    """Create floor, dock, stations and plates; hotel plates need the slot poses of the placed robot."""
+    scene = Scene()
+    half_floor = world.floor_size / 2
+    scene.floor = _static_box(
+        client,
+        (world.floor_size, world.floor_size, 0.02),
+        tf.make_transform((0, 0, -0.01)),
+        [0.85, 0.85, 0.85, 1],
+    )
+    log.debug("floor %.1f m square (half %.1f)", world.floor_size, half_floor)
+    T_world_dock = world.dock_pose.matrix() @ tf.make_transform(
+        (-(BASE_RADIUS + DOCK_GAP + DOCK_SIZE[0] / 2), 0, DOCK_SIZE[2] / 2)
+    )
+    scene.dock = _static_box(client, DOCK_SIZE, T_world_dock, [0.2, 0.3, 0.2, 1])
+    default_type = next(iter(world.labware_types.values()))
+    for station in world.stations:
+        _build_station(client, station, default_type, scene)
+    for plate in world.plates:
+        labware = world.labware_types[plate.labware_type]
+        if plate.hotel_slot:
+            if T_world_hotel_slots is None:
+                raise ValueError(f"plate {plate.labware_id} starts in the hotel but no slot poses were given")
+            T_world_bottom = T_world_hotel_slots[plate.hotel_slot]
+        else:
+            T_world_bottom = world.station(plate.station).T_world_site(plate.sub_position)
+        scene.plates[plate.labware_id] = _plate_body(client, labware, T_world_bottom)
+        scene.plate_types[plate.labware_id] = labware
+    return scene

@@ -1,0 +1,592 @@
+"""The simulated TIAGo++ in its lab: the Simulation API the ROS node calls (see the module contract).
+
+Why one class: it owns the PyBullet client (DIRECT, fixed step) and is the only place where
+physics advances; motions are started by methods that return a Motion at once and run as step()
+is called. Sensors report what the robot could know (odometry, joint encoders, dock contact,
+gripper contact); ``check_placement`` is ground truth for success checks only.
+Lives on one thread (the sim thread): every method must be called there.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+import pybullet as p
+
+from tiago_sim import transforms as tf
+from tiago_sim.lab.world import World
+from tiago_sim.perception.camera import CameraIntrinsics, render_rgbd
+from tiago_sim.physics.arm_controller import JointTrajectoryMotion
+from tiago_sim.physics.base_controller import DiffDriveBase, DriveMotion
+from tiago_sim.physics.gripper_controller import Gripper, GripperMotion
+from tiago_sim.physics.hotel_clamp import HotelClamp
+from tiago_sim.physics.motion import BUSY, CompletedMotion, FailedMotion, Motion, SequenceMotion
+from tiago_sim.physics.robot_body import RobotBody
+from tiago_sim.physics.scene import build_scene, plate_bottom_pose
+from tiago_sim.robot import robot_model as rm
+from tiago_sim.robot.kinematics import RobotKinematics
+
+log = logging.getLogger(__name__)
+
+# Solver iterations by situation: the notes' 150 while fingers close or open on a plate; 20 otherwise
+# (joint tracking error stays under 1 mrad). A plate held by a gripper or riding the hotel is fixed
+# by a constraint (the travel attach, the hotel clamp), so it needs no more: at 20 instead of 30
+# the physics of a benchmark transfer took 3.8 instead of 4.8 s CPU and the placement error stayed
+# at 1.0 to 1.6 mm (seeds 1 to 3).
+SOLVER_ITERATIONS_GRASPING = 150
+SOLVER_ITERATIONS = 20
+# Physics step: the notes' 1/240 s whenever a gripper moves, or a moving link (arm, torso, head)
+# comes within PLATE_NEAR_RANGE of a plate resting anywhere, or a held plate comes within reach of
+# anything but its own arm (grasp, place, release, into and out of the hotel); FREE_MOTION_STEP_RATIO
+# times that otherwise (driving, free arm moves, carrying through free space), where only joint
+# tracking, the kinematic base and constrained plates are simulated. The long step is the largest
+# saving of wall time per simulated second: 1/60 s halved the steps of the free phases against
+# 1/120 s (a benchmark transfer: 2230 instead of 4260 steps, 0.6 s CPU less) with the marker-guided
+# alignment, the placement and the docking as accurate as before. A plate resting in the hotel by
+# contact alone used to keep the steps short while the base turned (it crept outwards per step on
+# the curved path); the hotel clamp now holds it while the base moves.
+FREE_MOTION_STEP_RATIO = 4
+# Error reduction of joint constraints (the base carrier) per step: Bullet's 0.2 at 1/240 s, 0.5 at
+# the long step, so that the base lags its commanded pose by the same 17 ms at either step (about
+# step * (1 - erp) / erp; measured at 0.27 and 0.53 m/s: 16.7 ms at 1/240 s and 0.2, 20.4 ms at
+# 1/60 s and 0.45, 11.1 ms at 1/60 s and 0.6).
+CONSTRAINT_ERP = 0.2
+FREE_MOTION_CONSTRAINT_ERP = 0.5
+PLATE_NEAR_RANGE = 0.15  # m between a moving robot link and a plate: a finger contact may start soon
+STEP_REVIEW_PERIOD = 0.05  # s of sim time between proximity checks (tool <= 1.5 m/s: 7.5 cm)
+# A held plate is within reach of something when it is closer than this margin plus twice the
+# distance it travels in a review period at its current speed (it cannot get there unnoticed).
+HELD_PLATE_MARGIN = 0.03  # m
+LOADED_TURN_RATE = 0.05  # rad/s: above it, with an unclamped plate in the hotel, steps stay short
+DOCK_SENSOR_RANGE = 0.004  # m: the charging contacts close within this distance
+DOCK_SPEED = 0.05  # m/s backing onto the dock: stops within 3 mm once the contacts close
+DOCK_OVERTRAVEL = 0.08  # m: the reverse drive aims this far past the docked pose, contact ends it
+TOOL_SPEED = 0.08  # m/s along straight tool moves unless the caller asks otherwise
+STRAIGHT_STEP = 0.01  # m between IK waypoints
+MAX_WAYPOINT_JUMP = 0.25  # rad between consecutive IK waypoints
+# A delivered plate rests in its nest when it is within the nest's clearance + this per axis and
+# under the other limits (the success check of every transfer).
+PLACED_BEYOND_CLEARANCE_MM = 1.0
+PLACED_HEIGHT_TOLERANCE_MM = 2.0
+PLACED_YAW_TOLERANCE_DEG = 2.0
+PLACED_TILT_TOLERANCE_DEG = 1.0
+NEST_SENSOR_RANGE = 0.02  # m: presence sensor sees a plate whose centre is this close to the site
+
+# Arms folded beside the torso (PAL's "home"), head level.
+HOME_ARM = (0.2, -1.1, -0.2, 1.94, -1.57, 1.37, 0.0)
+HOME_TORSO = 0.15
+
+
+@dataclass(frozen=True)
+class PlacementCheck:
+    """Ground truth about one plate (CheckPlacement service)."""
+
+    found: bool
+    in_nest: bool
+    position_error_m: float
+    yaw_error_rad: float
+    location: str
+    outside: str = ""  # in the expected nest but not in_nest: every limit it missed
+
+
+class StepLedger:
+    """Physics steps and the CPU they took, by step length and solver iterations.
+
+    Why: the physics step is most of the sim thread's CPU; which regime eats it tells where a
+    faster simulation has to come from (logged when the sim thread stops)."""
+
+    def __init__(self) -> None:
+        self.entries: dict[tuple[float, int], list[float]] = {}  # -> [steps, sim s, CPU s]
+
+    def record(self, step_s: float, iterations: int, cpu_s: float) -> None:
+        entry = self.entries.setdefault((step_s, iterations), [0, 0.0, 0.0])
+        entry[0] += 1
+        entry[1] += step_s
+        entry[2] += cpu_s
+
+    def summary(self) -> str:
+        rows = sorted(self.entries.items(), key=lambda item: -item[1][2])
+        return "; ".join(
+            f"1/{round(1 / step_s)} s x {iterations} iterations: {int(steps)} steps, "
+            f"{sim_s:.1f} s simulated, {cpu_s:.2f} s CPU ({cpu_s / steps * 1000:.2f} ms/step)"
+            for (step_s, iterations), (steps, sim_s, cpu_s) in rows
+        )
+
+
+class Simulation:
+    """PyBullet world + robot; see the module docstring for threading."""
+
+    def __init__(
+        self,
+        world: World,
+        *,
+        seed: int | None = None,
+        time_step: float = 1 / 240,
+        odometry_noise: float = 0.0005,
+    ) -> None:
+        self.world = world
+        self._nest_sites_of: World | None = None
+        self._nest_sites_cache: list[tuple[str, int, np.ndarray]] = []
+        self.time_step = time_step
+        self.sim_time = 0.0
+        self.rng = np.random.default_rng(seed)
+        self.client_id = p.connect(p.DIRECT)
+        c = self.client_id
+        p.setGravity(0, 0, -9.81, physicsClientId=c)
+        p.setPhysicsEngineParameter(
+            fixedTimeStep=time_step,
+            numSolverIterations=SOLVER_ITERATIONS,
+            erp=CONSTRAINT_ERP,
+            physicsClientId=c,
+        )
+        self.robot = RobotBody(c, world.dock_pose.matrix())
+        self._reset_posture()
+        self.T_world_slot_at_start = {
+            i: self.robot.link_pose(f"hotel_slot_{i}") for i in range(1, world.hotel_slots + 1)
+        }
+        self.scene = build_scene(c, world, self.T_world_slot_at_start)
+        dock = world.dock_pose
+        self.base = DiffDriveBase(self.robot, dock.x, dock.y, dock.yaw, odometry_noise, self.rng)
+        self.grippers = {side: Gripper(self.robot, side, self.scene.plates) for side in rm.ARM_SIDES}
+        self.hotel_clamp = HotelClamp(self.robot, self.scene.plates)
+        self._clamped_for_drive = False
+        self._own_arm_links = {
+            side: {
+                index
+                for name, index in self.robot.link_index.items()
+                if name.startswith((f"arm_{side}_", f"gripper_{side}_"))
+            }
+            for side in rm.ARM_SIDES
+        }
+        self.kinematics = RobotKinematics()
+        self.motions: list[Motion] = []
+        self._iterations = SOLVER_ITERATIONS
+        self._step = time_step
+        self.last_step_s = time_step  # length of the latest physics step (s)
+        self.step_ledger = StepLedger()
+        self._reviewed_at = -1.0
+        self._plate_within_range = True
+        self._turning_loaded = False
+        for _ in range(int(0.5 / time_step)):  # let plates settle in their nests
+            self.step()
+
+    def _reset_posture(self) -> None:
+        """Initial configuration (before any physics step): arms home, torso down a little."""
+        posture = {"torso_lift_joint": HOME_TORSO}
+        for side in rm.ARM_SIDES:
+            posture.update(dict(zip(rm.arm_joint_names(side), HOME_ARM, strict=True)))
+            posture.update({name: rm.FINGER_TRAVEL for name in rm.finger_joint_names(side)})
+        for name, value in posture.items():
+            p.resetJointState(
+                self.robot.id, self.robot.joint_index[name], value, physicsClientId=self.client_id
+            )
+        hold = {n: v for n, v in posture.items() if "finger" not in n}
+        hold.update({"head_1_joint": 0.0, "head_2_joint": 0.0})
+        self.robot.command_positions(hold)
+
+    def close(self) -> None:
+        if p.isConnected(self.client_id):
+            p.disconnect(self.client_id)
+
+    # ----------------------------------------------------------------- stepping
+    def step(self) -> None:
+        """Advance by one physics step (``time_step``, or a multiple of it in free motion)."""
+        dt = self._choose_step()
+        motions = self.motions
+        base_driven = False
+        for motion in motions:
+            motion.advance(dt)
+            base_driven = base_driven or ("base" in motion.resources and not motion.done)
+        if not base_driven:
+            self.base.command(0.0, 0.0)  # no drive running: the base brakes and stands
+        self._clamp_while_driving(base_driven)
+        self.base.update(dt)
+        started = time.thread_time()
+        p.stepSimulation(physicsClientId=self.client_id)
+        self.step_ledger.record(dt, self._iterations, time.thread_time() - started)
+        self.base.integrate_odometry(dt)
+        self.sim_time += dt
+        self.last_step_s = dt
+        if any(m.done for m in motions):
+            self.motions = [m for m in motions if not m.done]
+
+    def _clamp_while_driving(self, base_driven: bool) -> None:
+        """The hotel clamp closes when a base motion starts and opens once the base stands."""
+        if base_driven and not self._clamped_for_drive:
+            self.hotel_clamp.close(held=self._held_plates())
+            self._clamped_for_drive = True
+        elif not base_driven and self._clamped_for_drive and self.base.stopped():
+            self.hotel_clamp.open()
+            self._clamped_for_drive = False
+
+    def _held_plates(self) -> set[str]:
+        return {g.attached_id for g in self.grippers.values() if g.attached_id}
+
+    def _choose_step(self) -> float:
+        """Solver iterations and step length for the coming step (see the constants above)."""
+        grasping = any(isinstance(m, GripperMotion) for m in self.motions)
+        if not grasping and self.sim_time - self._reviewed_at >= STEP_REVIEW_PERIOD - 1e-9:
+            self._reviewed_at = self.sim_time
+            self._plate_within_range = self._robot_near_resting_plate() or self._held_plate_near_anything()
+            turn_rate = max(abs(self.base.w), abs(self.base.w_cmd))
+            self._turning_loaded = turn_rate > LOADED_TURN_RATE and bool(
+                self.hotel_clamp.resting_on_tray(self._held_plates() | set(self.hotel_clamp.constraints))
+            )
+        iterations = SOLVER_ITERATIONS_GRASPING if grasping else SOLVER_ITERATIONS
+        if iterations != self._iterations:
+            self._iterations = iterations
+            p.setPhysicsEngineParameter(numSolverIterations=iterations, physicsClientId=self.client_id)
+        short = grasping or self._plate_within_range or self._turning_loaded
+        step = self.time_step if short else self.time_step * FREE_MOTION_STEP_RATIO
+        if step != self._step:
+            self._step = step
+            erp = CONSTRAINT_ERP if step == self.time_step else FREE_MOTION_CONSTRAINT_ERP
+            p.setPhysicsEngineParameter(fixedTimeStep=step, erp=erp, physicsClientId=self.client_id)
+        return step
+
+    def _robot_near_resting_plate(self) -> bool:
+        """A robot link other than the base (its hotel tray carries plates) near a plate no gripper holds."""
+        held = self._held_plates()
+        return any(
+            point[3] != -1
+            for labware_id, plate in self.scene.plates.items()
+            if labware_id not in held
+            for point in p.getClosestPoints(
+                self.robot.id, plate, PLATE_NEAR_RANGE, physicsClientId=self.client_id
+            )
+        )
+
+    def _held_plate_near_anything(self) -> bool:
+        """A held plate within reach of a body, or of a robot link other than its own arm's."""
+        c = self.client_id
+        for side, gripper in self.grippers.items():
+            if not gripper.attached_id:
+                continue
+            plate = self.scene.plates[gripper.attached_id]
+            speed = float(np.linalg.norm(p.getBaseVelocity(plate, physicsClientId=c)[0]))
+            reach = HELD_PLATE_MARGIN + 2.0 * speed * STEP_REVIEW_PERIOD
+            own_links = self._own_arm_links[side]
+            for index in range(p.getNumBodies(physicsClientId=c)):
+                other = p.getBodyUniqueId(index, physicsClientId=c)
+                if other == plate:
+                    continue
+                for point in p.getClosestPoints(plate, other, reach, physicsClientId=c):
+                    if other != self.robot.id or point[4] not in own_links:
+                        return True
+        return False
+
+    def busy(self) -> bool:
+        return any(not m.done for m in self.motions)
+
+    def run(self, motion: Motion, timeout_s: float = 120.0) -> Motion:
+        """Step until ``motion`` is done (helper for scripts and tests)."""
+        end = self.sim_time + timeout_s
+        while not motion.done and self.sim_time < end:
+            self.step()
+        if not motion.done:
+            motion.cancel()
+            for _ in range(int(2.0 / self.time_step)):
+                self.step()
+                if motion.done:
+                    break
+        return motion
+
+    def _start(self, motion: Motion) -> Motion:
+        if motion.done:
+            return motion
+        taken = set().union(*(m.resources for m in self.motions)) if self.motions else set()
+        if motion.resources & taken:
+            return FailedMotion(motion.name, BUSY, f"busy: {sorted(motion.resources & taken)}")
+        self.motions.append(motion)
+        return motion
+
+    # ----------------------------------------------------------------- sensors
+    def odometry(self) -> tuple[float, float, float]:
+        x, y, yaw = self.base.odom
+        return float(x), float(y), float(yaw)
+
+    def joint_positions(self) -> dict[str, float]:
+        return self.robot.joint_positions()
+
+    def is_docked(self) -> bool:
+        points = p.getClosestPoints(
+            self.robot.id, self.scene.dock, DOCK_SENSOR_RANGE, linkIndexA=-1, physicsClientId=self.client_id
+        )
+        return bool(points)
+
+    def render_head_camera(self, supersample: int = 1) -> tuple[np.ndarray, np.ndarray, CameraIntrinsics]:
+        intrinsics = CameraIntrinsics()
+        T_world_optical = self.robot.link_pose("head_camera_optical_frame")
+        rgb, depth = render_rgbd(self.client_id, T_world_optical, intrinsics, supersample=supersample)
+        return rgb, depth, intrinsics
+
+    def _plate_bottom(self, labware_id: str) -> np.ndarray:
+        body = self.scene.plates[labware_id]
+        return plate_bottom_pose(self.client_id, body, self.scene.plate_types[labware_id])
+
+    def _site_offset(self, T_world_site: np.ndarray, labware_id: str) -> np.ndarray:
+        return tf.invert(T_world_site) @ self._plate_bottom(labware_id)
+
+    def _plate_bottom_points(self) -> list[tuple[str, np.ndarray]]:
+        """World position of every plate's bottom centre (one query per plate, shared by all sensors)."""
+        points = []
+        for labware_id, body in self.scene.plates.items():
+            position, quat = p.getBasePositionAndOrientation(body, physicsClientId=self.client_id)
+            up = np.array(p.getMatrixFromQuaternion(quat)[2::3])  # the plate's z axis
+            half_height = self.scene.plate_types[labware_id].height / 2
+            points.append((labware_id, np.asarray(position) - half_height * up))
+        return points
+
+    @staticmethod
+    def _plate_near(T_world_site: np.ndarray, bottoms: list[tuple[str, np.ndarray]]) -> str:
+        """The plate whose bottom centre the presence sensor of this site sees, or ""."""
+        for labware_id, point in bottoms:
+            offset = T_world_site[:3, :3].T @ (point - T_world_site[:3, 3])
+            if math.hypot(offset[0], offset[1]) < NEST_SENSOR_RANGE and abs(offset[2]) < 0.01:
+                return labware_id
+        return ""
+
+    def _nest_sites(self) -> list[tuple[str, int, np.ndarray]]:
+        """(station, sub-position, T_world_site) of every nest; the stations never move, so cached."""
+        if self._nest_sites_of is not self.world:
+            self._nest_sites_cache = [
+                (station.name, sub, station.T_world_site(sub))
+                for station in self.world.stations
+                for sub in range(1, station.sub_positions + 1)
+            ]
+            self._nest_sites_of = self.world
+        return self._nest_sites_cache
+
+    def nest_occupancy(self) -> list[tuple[str, int, bool, str]]:
+        bottoms = self._plate_bottom_points()
+        result = []
+        for name, sub, T_world_site in self._nest_sites():
+            labware_id = self._plate_near(T_world_site, bottoms)
+            result.append((name, sub, bool(labware_id), labware_id))
+        return result
+
+    def hotel_occupancy(self) -> list[tuple[int, str, str]]:
+        bottoms = self._plate_bottom_points()
+        result = []
+        for slot in range(1, self.world.hotel_slots + 1):
+            labware_id = self._plate_near(self.robot.link_pose(f"hotel_slot_{slot}"), bottoms)
+            labware_type = self.scene.plate_types[labware_id].name if labware_id else ""
+            result.append((slot, labware_id, labware_type))
+        return result
+
+    def held_labware(self, arm: str) -> str:
+        """Plate between that gripper's pads (both touching), or the one attached after a verified grasp."""
+        gripper = self.grippers[arm]
+        return gripper.touching() or gripper.attached_id
+
+    # ----------------------------------------------------------------- motions
+    def drive_to(self, x: float, y: float, yaw: float, speed: float = rm.MAX_LINEAR_SPEED) -> Motion:
+        if self.is_docked():
+            return FailedMotion("drive", "DOCKED", "undock first")
+        return self._start(DriveMotion(self.base, x, y, yaw, speed=speed))
+
+    def dock(self) -> Motion:
+        if self.is_docked():
+            return CompletedMotion("dock", "already docked")
+        approach = self.world.pois[self.world.dock_poi]
+        dock = self.world.dock_pose
+        beyond = (
+            dock.x - DOCK_OVERTRAVEL * math.cos(dock.yaw),
+            dock.y - DOCK_OVERTRAVEL * math.sin(dock.yaw),
+        )
+        stages = [
+            ("approach", lambda: DriveMotion(self.base, approach.x, approach.y, approach.yaw), 0.7),
+            (
+                "docking",
+                lambda: DriveMotion(
+                    self.base,
+                    *beyond,
+                    dock.yaw,
+                    reverse=True,
+                    speed=DOCK_SPEED,
+                    stop_when=self.is_docked,
+                    name="dock_in",
+                ),
+                0.3,
+            ),
+        ]
+        return self._start(SequenceMotion("dock", stages, frozenset({"base"})))
+
+    def undock(self) -> Motion:
+        """Drive straight ahead off the dock, as far as the dock POI lies in front of the dock."""
+        if not self.is_docked():
+            return CompletedMotion("undock", "not docked")
+        x, y, yaw = self.odometry()
+        distance = math.dist(
+            (self.world.dock_pose.x, self.world.dock_pose.y),
+            (self.world.pois[self.world.dock_poi].x, self.world.pois[self.world.dock_poi].y),
+        )
+        goal = (x + distance * math.cos(yaw), y + distance * math.sin(yaw), yaw)
+        motion = DriveMotion(self.base, *goal, speed=0.3, name="undock")  # contacts open at once: no creep
+        motion.phase = "driving"
+        return self._start(motion)
+
+    def move_joints(self, targets: dict[str, float], speed_scale: float = 1.0) -> Motion:
+        unknown = [n for n in targets if n not in self.robot.joint_index]
+        if unknown or not targets:
+            return FailedMotion(
+                "move_joints", "BAD_GOAL", f"unknown joints {unknown}" if unknown else "no targets"
+            )
+        resources = frozenset(self._joint_resource(n) for n in targets)
+        return self._start(
+            JointTrajectoryMotion(self.robot, [dict(targets)], speed_scale, resources=resources)
+        )
+
+    @staticmethod
+    def _joint_resource(name: str) -> str:
+        for side in rm.ARM_SIDES:
+            if name.startswith(f"arm_{side}_"):
+                return f"arm_{side}"
+            if name.startswith(f"gripper_{side}_"):
+                return f"gripper_{side}"
+        return name.split("_")[0]  # torso, head, wheel
+
+    def move_tool(
+        self,
+        arm: str,
+        T_base_grasp: np.ndarray,
+        straight_line: bool = True,
+        tool_speed: float = TOOL_SPEED,
+        use_torso: bool = True,
+    ) -> Motion:
+        """Grasping frame of ``arm`` to a pose in base_footprint, via IK waypoints when straight.
+
+        ``tool_speed`` (m/s) caps the speed along a straight line; the joint limits cap it too.
+        ``use_torso`` False keeps the torso still (it lifts at only 0.07 m/s and would set the pace).
+        """
+        if arm not in rm.ARM_SIDES:
+            return FailedMotion("move_tool", "BAD_GOAL", f"unknown arm {arm!r}")
+        current = self.joint_positions()
+        T_start = self.kinematics.forward(current, f"arm_{arm}_grasping_frame")
+        T_goal = np.asarray(T_base_grasp, dtype=float)
+        waypoints = _straight_path(T_start, T_goal) if straight_line else [T_goal]
+        solutions: list[dict[str, float]] = []
+        seed = dict(current)
+        for index, T_waypoint in enumerate(waypoints):
+            restarts = 30 if (index == 0 and not straight_line) else 3
+            result = self.kinematics.inverse(
+                arm,
+                T_waypoint,
+                seed,
+                use_torso=use_torso,
+                restarts=restarts,
+                seed=int(self.rng.integers(1 << 30)),
+            )
+            jump = max(
+                (abs(result.joint_positions[n] - seed[n]) for n in result.joint_positions), default=0.0
+            )
+            if straight_line and (not result.success or jump > MAX_WAYPOINT_JUMP):
+                # near a joint limit the seeded solve can stall: creep there in small, seeded steps
+                T_previous = waypoints[index - 1] if index else T_start
+                result = self._creep(arm, T_previous, T_waypoint, seed, use_torso) or result
+                jump = max(
+                    (abs(result.joint_positions[n] - seed[n]) for n in result.joint_positions), default=0.0
+                )
+            if not result.success or (straight_line and jump > MAX_WAYPOINT_JUMP):
+                why = "unreachable" if not result.success else f"joint jump {jump:.2f} rad"
+                return FailedMotion("move_tool", "IK_FAILED", f"waypoint {index + 1}/{len(waypoints)} {why}")
+            solutions.append(result.joint_positions)
+            seed.update(result.joint_positions)
+        segment_s = STRAIGHT_STEP / max(tool_speed, 1e-3) if straight_line else 0.0
+        resources = frozenset({f"arm_{arm}", "torso"})
+        motion = JointTrajectoryMotion(
+            self.robot, solutions, 1.0, name="move_tool", min_segment_s=segment_s, resources=resources
+        )
+        return self._start(motion)
+
+    def _creep(
+        self, arm: str, T_from: np.ndarray, T_to: np.ndarray, seed: dict[str, float], use_torso: bool = True
+    ):
+        """IK for T_to reached from T_from in seeded sub-steps (no random restarts), or None."""
+        here = dict(seed)
+        result = None
+        for T_sub in _straight_path(T_from, T_to, step=STRAIGHT_STEP / 5):
+            result = self.kinematics.inverse(
+                arm, T_sub, here, use_torso=use_torso, restarts=0, max_iterations=400
+            )
+            if not result.success:
+                return None
+            here.update(result.joint_positions)
+        return result
+
+    def gripper(self, arm: str, close: bool) -> Motion:
+        if arm not in rm.ARM_SIDES:
+            return FailedMotion("gripper", "BAD_GOAL", f"unknown arm {arm!r}")
+        return self._start(GripperMotion(self.grippers[arm], close))
+
+    # ----------------------------------------------------------------- ground truth
+    def check_placement(self, labware_id: str, station: str, sub_position: int) -> PlacementCheck:
+        if labware_id not in self.scene.plates:
+            return PlacementCheck(False, False, math.inf, math.inf, "unknown")
+        location = self._locate(labware_id)
+        if not station:
+            return PlacementCheck(True, False, math.nan, math.nan, location)
+        site = self.world.station(station)
+        offset = self._site_offset(site.T_world_site(sub_position), labware_id)
+        position_error = float(np.linalg.norm(offset[:2, 3]))
+        yaw_error = abs(tf.wrap_angle(tf.yaw_of(offset)))
+        tilt = tf.rotation_angle(np.eye(3), offset[:3, :3]) - yaw_error
+        margin_mm = 1000.0 * site.nest_clearance + PLACED_BEYOND_CLEARANCE_MM
+        x_mm, y_mm, z_mm = (1000.0 * float(v) for v in offset[:3, 3])
+        missed = [
+            f"{label} {value:.1f} {unit} (limit {limit:.1f})"
+            for label, value, unit, limit in (
+                ("off along the nest's long side by", abs(x_mm), "mm", margin_mm),
+                ("off across the nest by", abs(y_mm), "mm", margin_mm),
+                ("raised" if z_mm > 0 else "sunk", abs(z_mm), "mm", PLACED_HEIGHT_TOLERANCE_MM),
+                ("turned", math.degrees(yaw_error), "deg", PLACED_YAW_TOLERANCE_DEG),
+                ("tilted", abs(math.degrees(tilt)), "deg", PLACED_TILT_TOLERANCE_DEG),
+            )
+            if value >= limit
+        ]
+        outside = ", ".join(missed)
+        return PlacementCheck(True, not missed, position_error, float(yaw_error), location, outside)
+
+    def _locate(self, labware_id: str) -> str:
+        for _side, gripper in self.grippers.items():
+            if gripper.attached_id == labware_id or gripper.touching() == labware_id:
+                return "gripper"
+        for name, sub, _, found in self.nest_occupancy():
+            if found == labware_id:
+                return f"station:{name}:{sub}"
+        for slot, found, _ in self.hotel_occupancy():
+            if found == labware_id:
+                return f"hotel:{slot}"
+        if self._plate_bottom(labware_id)[2, 3] < 0.05:
+            return "floor"
+        return "unknown"
+
+
+def _straight_path(T_start: np.ndarray, T_goal: np.ndarray, step: float = STRAIGHT_STEP) -> list[np.ndarray]:
+    """Poses along the straight line (and the shortest rotation) from start to goal, goal last."""
+    distance = float(np.linalg.norm(T_goal[:3, 3] - T_start[:3, 3]))
+    angle = tf.rotation_angle(T_start[:3, :3], T_goal[:3, :3])
+    count = max(1, math.ceil(distance / step), math.ceil(angle / (5 * step)))
+    relative = T_start[:3, :3].T @ T_goal[:3, :3]
+    axis_angle = _log_rotation(relative)
+    poses = []
+    for i in range(1, count + 1):
+        s = i / count
+        pose = np.eye(4)
+        pose[:3, 3] = T_start[:3, 3] + s * (T_goal[:3, 3] - T_start[:3, 3])
+        pose[:3, :3] = T_start[:3, :3] @ _exp_rotation(s * axis_angle)
+        poses.append(pose)
+    return poses
+
+
+def _log_rotation(rotation: np.ndarray) -> np.ndarray:
+    return np.asarray(pin.log3(rotation))
+
+
+def _exp_rotation(vector: np.ndarray) -> np.ndarray:
+    return np.asarray(pin.exp3(vector))

@@ -1,0 +1,1 @@
+"""The TIAGo++ model without a simulator: URDF from primitive shapes, kinematics, named motions."""

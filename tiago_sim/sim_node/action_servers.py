@@ -1,0 +1,158 @@
+"""Action servers of the sim node: navigate, dock, undock, play motion, marker motion, gripper.
+
+Every server accepts a goal at once and decides in its execute callback: an unknown POI,
+station, slot or motion ends the goal immediately as aborted with a code and a reason (so the
+client reads why); a second motion while one runs ends with BUSY. The work itself is a sequence
+of steps on the sim thread (see action_run.ActionRun). Lives on: rclpy executor threads.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable
+from typing import Any
+
+from labware_interfaces.action import Dock, Gripper, MarkerMotion, NavigateToPoi, PlayMotion, Undock
+from labware_interfaces.msg import ErrorCodes, RobotState
+from rclpy.action import ActionServer, CancelResponse, GoalResponse
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.node import Node
+
+from tiago_sim.sim_node.action_run import ActionAbort, ActionRun, MotionSlot
+from tiago_sim.sim_node.sim_thread import SimThread
+
+log = logging.getLogger(__name__)
+
+# Codes after which the robot reports the error state until the next goal succeeds.
+FAULT_CODES = frozenset(
+    {
+        ErrorCodes.NAVIGATION_FAILED,
+        ErrorCodes.IK_FAILED,
+        ErrorCodes.MOTION_FAILED,
+        ErrorCodes.GRASP_FAILED,
+        ErrorCodes.PLATE_SLIPPED,
+        ErrorCodes.PLACE_FAILED,
+        ErrorCodes.INTERNAL,
+    }
+)
+
+# Execute functions receive the goal's ActionRun and the goal request; they return a dict of
+# extra result fields (beyond success/error_code/message) or raise ActionAbort.
+ExecuteFn = Callable[[ActionRun, Any], dict]
+
+
+class RobotActivity:
+    """What the robot is doing, for /robot_state (written by goals, read by the publisher)."""
+
+    def __init__(self) -> None:
+        self.state = ""  # "" (derive idle/docked from sensors), navigating, manipulating, error
+        self.detail = ""
+        self.last_error = ""
+
+    def snapshot(self) -> tuple[str, str]:
+        if self.state:
+            return self.state, self.detail
+        if self.last_error:
+            return RobotState.STATE_ERROR, self.last_error
+        return "", self.detail
+
+
+class RobotActionServers:
+    """Creates the six action servers on `node`; behaviour comes from the execute functions."""
+
+    def __init__(
+        self,
+        node: Node,
+        sim_thread: SimThread,
+        *,
+        navigate: ExecuteFn,
+        dock: ExecuteFn,
+        undock: ExecuteFn,
+        play_motion: ExecuteFn,
+        marker_motion: ExecuteFn,
+        gripper: ExecuteFn,
+        feedback_hz: float = 5.0,
+    ) -> None:
+        self.node = node
+        self.sim_thread = sim_thread
+        self.slot = MotionSlot()
+        self.activity = RobotActivity()
+        self.feedback_hz = feedback_hz
+        group = ReentrantCallbackGroup()
+        specs = [
+            ("/navigate_to_poi", NavigateToPoi, navigate, RobotState.STATE_NAVIGATING),
+            ("/dock", Dock, dock, RobotState.STATE_NAVIGATING),
+            ("/undock", Undock, undock, RobotState.STATE_NAVIGATING),
+            ("/play_motion", PlayMotion, play_motion, RobotState.STATE_MANIPULATING),
+            ("/marker_motion", MarkerMotion, marker_motion, RobotState.STATE_MANIPULATING),
+            ("/gripper", Gripper, gripper, RobotState.STATE_MANIPULATING),
+        ]
+        self.servers = [
+            ActionServer(
+                node,
+                action_type,
+                name,
+                self._execute_callback(name, action_type, execute, state),
+                callback_group=group,
+                goal_callback=lambda _goal: GoalResponse.ACCEPT,
+                cancel_callback=lambda _handle: CancelResponse.ACCEPT,
+            )
+            for name, action_type, execute, state in specs
+        ]
+
+    def _execute_callback(self, name: str, action_type: Any, execute: ExecuteFn, state: str) -> Callable:
+        def callback(goal_handle: Any) -> Any:
+            run = ActionRun(goal_handle, action_type.Feedback, self.sim_thread, feedback_hz=self.feedback_hz)
+            result = action_type.Result()
+            acquired = False
+            sim_started, busy_started = self.sim_thread.sim_time, self.sim_thread.busy_sim_s
+            try:
+                self.slot.acquire(name)
+                acquired = True
+                self.activity.state, self.activity.detail = state, name.lstrip("/")
+                run.feedback(0.0, "starting", 0.0, force=True)
+                extra = execute(run, goal_handle.request) or {}
+                for field_name, value in extra.items():
+                    setattr(result, field_name, value)
+                result.success, result.error_code, result.message = True, "", "done"
+                self.activity.last_error = ""
+                self.activity.detail = f"{name.lstrip('/')} done"
+                run.feedback(1.0, "done", 0.0, force=True)
+                goal_handle.succeed()
+            except ActionAbort as abort:
+                self._fill_failure(result, abort.code, abort.message, getattr(abort, "extra", None))
+                self._finish_failed(goal_handle, abort.code, name, abort.message, acquired)
+            except Exception as error:  # noqa: BLE001 - every goal ends with a result
+                log.exception("%s failed", name)
+                self._fill_failure(result, ErrorCodes.INTERNAL, f"internal error: {error}", None)
+                self._finish_failed(goal_handle, ErrorCodes.INTERNAL, name, str(error), acquired)
+            finally:
+                if acquired:
+                    self.activity.state = ""
+                    self.slot.release()
+                # one line per goal with its simulated span (tiago_sim.measuring.benchmark times phases by it)
+                log.info(
+                    "%s %s: sim %.3f .. %.3f s, %.3f s of it with no motion running",
+                    name, result.error_code or "done", sim_started, self.sim_thread.sim_time,
+                    self.sim_thread.sim_time - sim_started - (self.sim_thread.busy_sim_s - busy_started),
+                )  # fmt: skip
+            return result
+
+        return callback
+
+    @staticmethod
+    def _fill_failure(result: Any, code: str, message: str, extra: dict | None) -> None:
+        result.success, result.error_code, result.message = False, code, message
+        for field_name, value in (extra or {}).items():
+            setattr(result, field_name, value)
+
+    def _finish_failed(self, goal_handle: Any, code: str, name: str, message: str, acquired: bool) -> None:
+        if acquired:
+            self.activity.detail = f"{name.lstrip('/')}: {code}: {message}"
+            if code in FAULT_CODES:
+                self.activity.last_error = f"{name.lstrip('/')}: {code}: {message}"
+        log.info("%s ended: %s %s", name, code, message)
+        if code == ErrorCodes.CANCELED and goal_handle.is_cancel_requested:
+            goal_handle.canceled()
+        else:
+            goal_handle.abort()

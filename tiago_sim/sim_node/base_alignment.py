@@ -1,0 +1,125 @@
+"""Marker-guided final approach: from the station's POI to the working pose in front of the nests.
+
+Why: navigation ends a few centimetres and degrees off its goal (localisation error), and the
+onboard hotel tray reaches 0.33 m ahead of the base centre. Standing at the working distance
+straight from navigation, a 3 to 9 cm error made the turning base sweep the tray into the table
+and knock the plate out of its pocket (seeds 100 and 105 of the default campaign), or left the
+arm no room to unfold (seed 102). So navigation stops farther back (the station's ``standoff``,
+0.22 m behind the working pose: navigation error and odometry drift together reached 18 cm at
+seed 2041); then the robot looks at the station's marker, works out where the working pose
+(``work_standoff``) really is, and drives the last ~22 cm there. The torso rises to the bench
+working height and the head turns to the bench during that drive (independent joints overlap).
+
+Only robot knowledge is used: the head camera image and depth, joint readings, odometry and the
+kinematic model; the station's geometry comes from the believed (nominal) world file.
+Lives on: an rclpy executor thread (inside a /marker_motion goal).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from typing import Any
+
+import numpy as np
+from labware_interfaces.msg import ErrorCodes
+
+from tiago_sim import transforms as tf
+from tiago_sim.lab.world import Station
+from tiago_sim.robot.kinematics import RobotKinematics
+from tiago_sim.sim_node.action_run import ActionAbort, ActionRun
+
+log = logging.getLogger(__name__)
+
+HEAD_JOINTS = ("head_1_joint", "head_2_joint")
+CAMERA_FRAME = "head_camera_optical_frame"
+SEARCH_PAN_OFFSETS = (0.0, 0.45, -0.45, 0.9, -0.9)  # rad; the camera sees 63 deg across
+ALIGN_SPEED = 0.3  # m/s cap for the short final drive (the acceleration limit keeps it lower anyway)
+
+
+def head_angles_towards(kinematics: RobotKinematics, joints: dict[str, float], target: np.ndarray) -> dict:
+    """Pan and tilt that point the head at `target` (base_footprint), from the head joint origins."""
+    level = {**joints, "head_1_joint": 0.0, "head_2_joint": 0.0}
+    pan_origin = kinematics.forward(level, "head_1_link")[:3, 3]
+    pan = math.atan2(target[1] - pan_origin[1], target[0] - pan_origin[0])
+    tilt_origin = kinematics.forward({**level, "head_1_joint": pan}, "head_2_link")[:3, 3]
+    horizontal = math.hypot(target[0] - tilt_origin[0], target[1] - tilt_origin[1])
+    tilt = -math.atan2(tilt_origin[2] - target[2], horizontal)  # negative tilt looks down
+    for _ in range(3):  # the camera sits off both head axes: centre the target in the image
+        optical = kinematics.forward({**level, "head_1_joint": pan, "head_2_joint": tilt}, CAMERA_FRAME)
+        x, y, z = tf.invert(optical)[:3, :3] @ (target - optical[:3, 3])  # z ahead, x right, y down
+        pan -= math.atan2(x, z)
+        tilt -= math.atan2(y, z)
+    return {"head_1_joint": pan, "head_2_joint": tilt}
+
+
+def planar(transform: np.ndarray) -> tuple[float, float, float]:
+    """x, y and heading of a frame's x axis projected on the floor plane."""
+    return float(transform[0, 3]), float(transform[1, 3]), math.atan2(transform[1, 0], transform[0, 0])
+
+
+def compose_planar(
+    a: tuple[float, float, float], b: tuple[float, float, float]
+) -> tuple[float, float, float]:
+    """Planar pose b, given in the frame of planar pose a, expressed in a's parent frame."""
+    c, s = math.cos(a[2]), math.sin(a[2])
+    return a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], tf.wrap_angle(a[2] + b[2])
+
+
+def _search(run: ActionRun, head: dict[str, float], look: Any) -> Any:
+    """Point the head where the marker should be and look; if it is not in the image, pan left and
+    right and look again (odometry drifts over a long drive: seed 316 arrived 18 cm and 5 deg off
+    its belief). Every extra look is logged; MARKER_NOT_FOUND only when all of them fail."""
+    failure: ActionAbort | None = None
+    for index, pan_offset in enumerate(SEARCH_PAN_OFFSETS):
+        aim = {**head, "head_1_joint": head["head_1_joint"] + pan_offset}
+        if index:
+            log.info("marker not in view: looking %.0f deg further %s", abs(math.degrees(pan_offset)),
+                     "left" if pan_offset > 0 else "right")  # fmt: skip
+        run.run_motion(lambda sim, aim=aim: sim.move_joints(aim), span=(0.0, 0.15))
+        try:
+            return look(run)
+        except ActionAbort as abort:
+            if abort.code != ErrorCodes.MARKER_NOT_FOUND:
+                raise
+            failure = abort
+    assert failure is not None
+    raise failure
+
+
+def align_base(
+    run: ActionRun,
+    station: Station,
+    kinematics: RobotKinematics,
+    look: Any,
+    working_joints: dict[str, float],
+) -> Any:
+    """Look at the marker, drive to the working pose it implies, look again; returns the last sighting.
+
+    `look(run)` takes an image and returns the marker sighting (T_base_marker); `working_joints`
+    are torso/head targets that move while the base drives (e.g. the bench working posture).
+    """
+    joints = run.sim(lambda sim: dict(sim.joint_positions()))
+    T_world_poi = station.work_pose().matrix()  # where the robot believes navigation left it
+    T_base_marker_expected = tf.invert(T_world_poi) @ station.T_world_marker()
+    head = head_angles_towards(kinematics, joints, T_base_marker_expected[:3, 3])
+    # The torso starts rising at once (it is the slowest joint); the image is taken with the joint
+    # readings of the same instant, so the camera pose stays exact while it moves.
+    torso = {name: value for name, value in working_joints.items() if name not in HEAD_JOINTS}
+    lifting = run.sim(lambda sim: sim.move_joints(torso)) if torso else None
+    sighting = _search(run, head, look)
+    T_marker_work = tf.invert(station.T_world_marker()) @ station.aligned_pose().matrix()
+    correction = planar(sighting.T_base_marker @ T_marker_work)  # working pose in base_footprint
+    odometry = run.sim(lambda sim: tuple(sim.odometry()))
+    goal = compose_planar(odometry, correction)
+    log.info(
+        "aligning at %s: working pose at x %.3f y %.3f m, yaw %.1f deg from here",
+        station.name, correction[0], correction[1], math.degrees(correction[2]),
+    )  # fmt: skip
+    head_at_work = {name: value for name, value in working_joints.items() if name in HEAD_JOINTS}
+    turning = run.sim(lambda sim: sim.move_joints(head_at_work)) if head_at_work else None
+    run.run_motion(lambda sim: sim.drive_to(*goal, speed=ALIGN_SPEED), span=(0.2, 0.9))
+    for motion, span in ((lifting, (0.9, 0.95)), (turning, (0.95, 1.0))):
+        if motion is not None:
+            run.run_motion(lambda _sim, motion=motion: motion, span=span)
+    return look(run)  # from the working pose: later tool moves reuse it while the base stands

@@ -1,0 +1,274 @@
+"""The simulated TIAGo++ as a ROS 2 node: the one process that owns PyBullet.
+
+    python -m tiago_sim.sim_node --world FILE [--seed N] [--realtime-factor-cap X]
+
+Threads: the sim thread (sim_thread.SimThread) owns the Simulation and steps it; a
+MultiThreadedExecutor spins the node on the main thread; action execute callbacks and timers only
+hand jobs to the sim thread and wait on futures. Offers the robot-level actions (ros_actions),
+the sensor topics (ros_publishers), /describe_workcell and /check_placement (ground truth, for
+success checks only).
+
+ROS parameters (changeable at runtime): ``pois.<name>`` = [x, y, yaw] (from the world YAML),
+``stations.<name>.approach_height_m``, ``speed_scale``, ``realtime_factor_cap`` (0 = none),
+``idle_realtime_factor``, and - for tests only, as fault injection (tiago_sim.measuring.fault_injection) -
+``fault.occlude_marker``: a station name whose marker gets hidden behind a visual-only panel
+(empty: none); ``fault.remove_plate``: a plate id taken away onto the floor far from every station;
+``fault.drop_plate``: a plate id that slips out of the hotel during the next drive. Setting either
+plate fault to empty puts faulted plates back at their world-file nests.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import logging
+import sys
+from pathlib import Path
+from typing import Any
+
+from labware_interfaces.msg import StationInfo
+from labware_interfaces.srv import CheckPlacement, DescribeWorkcell
+from rcl_interfaces.msg import SetParametersResult
+from rclpy.executors import MultiThreadedExecutor
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+
+from tiago_sim.lab.world import DEFAULT_WORLD, World, WorldError, load_world
+from tiago_sim.measuring.fault_injection import Occluders, PlateFaults
+from tiago_sim.node_main import spin_node
+from tiago_sim.robot.motion_library import DEFAULT_MOTIONS_FILE, load_motions
+from tiago_sim.sim_node.action_servers import RobotActionServers
+from tiago_sim.sim_node.behaviours import RobotBehaviours
+from tiago_sim.sim_node.marker_motion import MarkerMotionBehaviour
+from tiago_sim.sim_node.publishers import StatePublishers
+from tiago_sim.sim_node.sim_thread import SimThread
+
+log = logging.getLogger("tiago_sim.sim_node")
+
+INVALID_WORLD_EXIT_CODE = 2
+"""Exit code for a world file that does not validate; the reason is the last line on stderr."""
+
+
+class SimNode:
+    """Wires the Simulation (on its thread) to ROS topics, services and actions."""
+
+    def __init__(self, node: Node, world: World, sim_thread: SimThread, motions_file: Path) -> None:
+        self.node = node
+        self.world = world
+        self.sim_thread = sim_thread
+        self.occluders = Occluders(world)
+        self.plate_faults = PlateFaults()
+        self._declare_parameters()
+        motions = load_motions(motions_file)
+        self.behaviours = RobotBehaviours(
+            poi_pose=self.poi_pose,
+            poi_names=lambda: sorted(self.current_pois()),
+            dock_poi=lambda: world.dock_poi,
+            hotel_slots=world.hotel_slots,
+            motions=motions,
+            speed_scale=lambda: float(node.get_parameter("speed_scale").value),
+        )
+        self.marker_motion = MarkerMotionBehaviour(world, self.behaviours, motions.hotel)
+        self.actions = RobotActionServers(
+            node,
+            sim_thread,
+            navigate=self.behaviours.navigate,
+            dock=self.behaviours.dock,
+            undock=self.behaviours.undock,
+            play_motion=self.behaviours.play_motion,
+            marker_motion=self.marker_motion,
+            gripper=self.behaviours.gripper,
+        )
+        self.publishers = StatePublishers(
+            node, sim_thread, pois=self.current_pois, activity=self.actions.activity.snapshot
+        )
+        node.create_service(DescribeWorkcell, "/describe_workcell", self._describe_workcell)
+        node.create_service(CheckPlacement, "/check_placement", self._check_placement)
+        node.add_on_set_parameters_callback(self._on_parameters)
+
+    # -- parameters ------------------------------------------------------------------------
+    def _declare_parameters(self) -> None:
+        for name, pose in self.world.pois.items():
+            self.node.declare_parameter(f"pois.{name}", [pose.x, pose.y, pose.yaw])
+        for station in self.world.stations:
+            self.node.declare_parameter(f"stations.{station.name}.approach_height_m", station.approach_height)
+        self.node.declare_parameter("speed_scale", 1.0)
+        self.node.declare_parameter("realtime_factor_cap", float(self.sim_thread.realtime_factor_cap or 0.0))
+        self.node.declare_parameter("idle_realtime_factor", float(self.sim_thread.idle_realtime_factor))
+        self.node.declare_parameter("fault.occlude_marker", "")
+        self.node.declare_parameter("fault.remove_plate", "")
+        self.node.declare_parameter("fault.drop_plate", "")
+
+    def _on_parameters(self, parameters: list[Parameter]) -> SetParametersResult:
+        for parameter in parameters:
+            name, value = parameter.name, parameter.value
+            if name.startswith("pois.") and (not isinstance(value, (list, tuple)) or len(value) != 3):
+                return SetParametersResult(successful=False, reason=f"{name} must be [x, y, yaw]")
+            if name == "speed_scale" and not 0.05 <= float(value) <= 2.0:
+                return SetParametersResult(successful=False, reason="speed_scale must be in 0.05 .. 2.0")
+            if (
+                name == "fault.occlude_marker"
+                and value
+                and value not in {s.name for s in self.world.stations}
+            ):
+                return SetParametersResult(successful=False, reason=f"unknown station {value!r}")
+            plates = {plate.labware_id for plate in self.world.plates}
+            if name in ("fault.remove_plate", "fault.drop_plate") and value and value not in plates:
+                return SetParametersResult(successful=False, reason=f"unknown plate {value!r}")
+        for parameter in parameters:
+            self._apply(parameter.name, parameter.value)
+        return SetParametersResult(successful=True)
+
+    def _apply(self, name: str, value: Any) -> None:
+        if name == "realtime_factor_cap":
+            self.sim_thread.realtime_factor_cap = float(value) if value and float(value) > 0 else None
+        elif name == "idle_realtime_factor":
+            self.sim_thread.idle_realtime_factor = float(value)
+        elif name == "fault.occlude_marker":
+            station = str(value)
+            self.sim_thread.call(lambda sim: self.occluders.set_occluded(sim, station))
+        elif name in ("fault.remove_plate", "fault.drop_plate"):
+            self.sim_thread.run(lambda sim: self._apply_plate_fault(sim, name, str(value)))
+        elif name.startswith("stations.") and name.endswith(".approach_height_m"):
+            station_name = name[len("stations.") : -len(".approach_height_m")]
+            stations = tuple(
+                dataclasses.replace(s, approach_height=float(value)) if s.name == station_name else s
+                for s in self.world.stations
+            )
+            self.world = dataclasses.replace(self.world, stations=stations)
+            self.marker_motion.world = self.world
+
+    def _apply_plate_fault(self, sim: Any, name: str, labware_id: str) -> None:
+        if not labware_id:
+            self.plate_faults.restore(sim)
+        elif name == "fault.remove_plate":
+            self.plate_faults.remove(sim, labware_id)
+        else:
+            self.plate_faults.arm_drop(sim, labware_id)
+            # Checked after every batch of steps: a wall-clock timer could miss a fast drive (seen
+            # under CI load: a 1 s drive went by without the check seeing the base at speed).
+            self.sim_thread.watch(self.plate_faults.drop_if_driving)
+
+    def current_pois(self) -> dict[str, tuple[float, float, float]]:
+        pois = {}
+        for name in self.world.pois:
+            value = self.node.get_parameter(f"pois.{name}").value
+            pois[name] = (float(value[0]), float(value[1]), float(value[2]))
+        return pois
+
+    def poi_pose(self, name: str) -> tuple[float, float, float] | None:
+        return self.current_pois().get(name)
+
+    # -- services -------------------------------------------------------------------------
+    def _describe_workcell(self, _request: Any, response: Any) -> Any:
+        response.stations = [
+            StationInfo(name=s.name, sub_positions=s.sub_positions, poi=s.poi) for s in self.world.stations
+        ]
+        response.hotel_slots = self.world.hotel_slots
+        response.pois = sorted(self.world.pois)
+        response.dock_poi = self.world.dock_poi
+        return response
+
+    def _check_placement(self, request: Any, response: Any) -> Any:
+        try:
+            check = self.sim_thread.run(
+                lambda sim: sim.check_placement(
+                    request.labware_id, request.station, int(request.sub_position)
+                )
+            )
+        except Exception as error:  # noqa: BLE001 - answer "unknown" rather than fail the call
+            log.warning("check_placement failed: %s", error)
+            response.found, response.location = False, "unknown"
+            return response
+        response.found = bool(check.found)
+        response.in_nest = bool(check.in_nest)
+        response.position_error_m = float(check.position_error_m)
+        response.yaw_error_rad = float(check.yaw_error_rad)
+        response.location = str(check.location)
+        response.outside = str(check.outside)
+        return response
+
+
+def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(prog="python -m tiago_sim.sim_node", description=__doc__.split("\n")[0])
+    parser.add_argument("--world", type=Path, default=DEFAULT_WORLD, help="world YAML (default: %(default)s)")
+    parser.add_argument("--seed", type=int, default=None, help="seed for odometry noise and IK restarts")
+    parser.add_argument(
+        "--realtime-factor-cap",
+        type=float,
+        default=None,
+        help="at most this many times real time (default: none)",
+    )
+    parser.add_argument("--motions", type=Path, default=DEFAULT_MOTIONS_FILE, help="keyframe motions YAML")
+    parser.add_argument(
+        "--disturbance-seed", type=int, default=None, help="seed of tiago_sim.measuring.disturbances"
+    )
+    parser.add_argument("--disturbance-levels", default="", help="DisturbanceLevels JSON")
+    parser.add_argument("--record-dir", type=Path, default=None, help="save camera frames here")
+    parser.add_argument("--log-level", default="INFO")
+    return parser.parse_args(argv)
+
+
+def make_simulation(simulation_class: Any, world: World, args: argparse.Namespace) -> Any:
+    """The Simulation, built in the true (disturbed) world when a disturbance seed is given."""
+    if args.disturbance_seed is None:
+        sim = simulation_class(world, seed=args.seed)
+    else:
+        from tiago_sim.measuring import disturbances
+
+        disturbance = disturbances.draw(world, args.disturbance_seed, _levels(args))
+        sim = simulation_class(
+            disturbances.true_world(world, disturbance),
+            seed=args.disturbance_seed if args.seed is None else args.seed,
+            odometry_noise=disturbance.levels.odometry_noise,
+        )
+        disturbances.apply_to_simulation(sim, disturbance)
+    if args.record_dir is not None:
+        from tiago_sim.measuring.run_recorder import RunRecorder
+
+        RunRecorder(sim, world, args.record_dir)
+    return sim
+
+
+def robot_world(world: World, args: argparse.Namespace) -> World:
+    """What the robot's behaviours believe: nominal, with POIs where navigation really stops."""
+    if args.disturbance_seed is None:
+        return world
+    from tiago_sim.measuring import disturbances
+
+    return disturbances.believed_world(world, disturbances.draw(world, args.disturbance_seed, _levels(args)))
+
+
+def _levels(args: argparse.Namespace) -> Any:
+    from tiago_sim.measuring.disturbances import DisturbanceLevels
+
+    levels_json = args.disturbance_levels
+    return DisturbanceLevels.from_json(levels_json) if levels_json else DisturbanceLevels()
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parse_args(argv)
+    logging.basicConfig(level=args.log_level, format="%(asctime)s %(levelname)s %(name)s: %(message)s")
+    try:
+        world = load_world(args.world)
+    except WorldError as error:
+        # One line (YAML parser messages span several) that a parent process can show as it is.
+        sys.stderr.write(f"invalid world file: {' '.join(str(error).split())}\n")
+        return INVALID_WORLD_EXIT_CODE
+    from tiago_sim.physics.simulation import (
+        Simulation,  # heavy import (PyBullet), only in the process that owns it
+    )
+
+    sim_thread = SimThread(
+        lambda: make_simulation(Simulation, world, args), realtime_factor_cap=args.realtime_factor_cap
+    )
+
+    def build(node: Node) -> SimNode:
+        sim_thread.start()
+        sim_node = SimNode(node, robot_world(world, args), sim_thread, args.motions)
+        log.info("sim node ready: world %s, %d stations", world.source, len(world.stations))
+        return sim_node
+
+    return spin_node(
+        "tiago_sim", lambda: MultiThreadedExecutor(num_threads=8), build, before_shutdown=sim_thread.stop
+    )

@@ -1,0 +1,289 @@
+"""Topics of the sim node: /clock, /odom, /joint_states, /robot_state, /station_states, camera.
+
+A wall-clock timer (executor thread) takes one snapshot of the robot's own sensors from the sim
+thread and publishes it; nothing here touches PyBullet directly. /robot_state goes out when it
+changes and at 2 Hz; /station_states likewise; the head camera only while someone subscribes.
+Lives on: the rclpy executor threads of the sim node.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+from builtin_interfaces.msg import Time
+from geometry_msgs.msg import Pose2D
+from labware_interfaces.msg import HotelSlot, NestState, RobotState, StationStates
+from nav_msgs.msg import Odometry
+from rclpy.node import Node
+from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import CameraInfo, Image, JointState
+
+from tiago_sim.sim_node.sim_thread import SimThread
+from tiago_sim.transforms import wrap_angle
+
+log = logging.getLogger(__name__)
+
+CAMERA_IMAGE_TOPIC = "/head_front_camera/rgb/image_raw"
+CAMERA_INFO_TOPIC = "/head_front_camera/rgb/camera_info"
+CAMERA_FRAME = "head_camera_optical_frame"
+
+
+@dataclass(frozen=True)
+class RobotSnapshot:
+    """What the robot's own sensors report at one instant of simulated time."""
+
+    sim_time: float
+    odometry: tuple[float, float, float]
+    joint_positions: dict[str, float]
+    docked: bool
+    hotel: list[tuple[int, str, str]]
+    held_labware_id: str
+    nests: list[tuple[str, int, bool, str]] = field(default_factory=list)
+    true_base_pose: tuple[float, float, float] | None = None  # simulator truth, for measurement only
+    activity: tuple[str, str] = ("", "")  # (state or "", detail) of the action servers at that instant
+
+
+def take_snapshot(sim: Any) -> RobotSnapshot:
+    """Read the sensors (runs on the sim thread)."""
+    held = ""
+    for arm in ("right", "left"):
+        held = held or sim.held_labware(arm)
+    return RobotSnapshot(
+        sim_time=float(sim.sim_time),
+        odometry=tuple(float(v) for v in sim.odometry()),
+        joint_positions=dict(sim.joint_positions()),
+        docked=bool(sim.is_docked()),
+        hotel=list(sim.hotel_occupancy()),
+        held_labware_id=held,
+        nests=list(sim.nest_occupancy()),
+        true_base_pose=_true_base_pose(sim),
+    )
+
+
+def _true_base_pose(sim: Any) -> tuple[float, float, float] | None:
+    """Ground-truth floor pose of the base, if the simulation exposes it (benchmarks only)."""
+    robot = getattr(sim, "robot", None)
+    if robot is None or not hasattr(robot, "base_pose"):
+        return None
+    T_world_base = robot.base_pose()
+    return (
+        float(T_world_base[0, 3]),
+        float(T_world_base[1, 3]),
+        math.atan2(T_world_base[1, 0], T_world_base[0, 0]),
+    )
+
+
+def _occupied_nests(nests: tuple) -> str:
+    """'station_a:1=plate_001, ...' for the log: which nests hold which plate."""
+    return ", ".join(f"{station}:{sub}={plate}" for station, sub, occupied, plate in nests if occupied)
+
+
+def stamp_of(sim_time: float) -> Time:
+    seconds = math.floor(sim_time)
+    return Time(sec=int(seconds), nanosec=int((sim_time - seconds) * 1e9))
+
+
+def poi_at(
+    pose: tuple[float, float, float],
+    pois: dict[str, tuple[float, float, float]],
+    position_tolerance_m: float,
+    yaw_tolerance_rad: float,
+) -> str:
+    """Name of the POI the base stands at (within tolerance), or ""."""
+    x, y, yaw = pose
+    best, best_distance = "", position_tolerance_m
+    for name, (px, py, pyaw) in pois.items():
+        distance = math.hypot(px - x, py - y)
+        if distance <= best_distance and abs(wrap_angle(pyaw - yaw)) <= yaw_tolerance_rad:
+            best, best_distance = name, distance
+    return best
+
+
+class StatePublishers:
+    """Publishes the sim node's topics from periodic sensor snapshots."""
+
+    def __init__(
+        self,
+        node: Node,
+        sim_thread: SimThread,
+        *,
+        pois: Callable[[], dict[str, tuple[float, float, float]]],
+        activity: Callable[[], tuple[str, str]],
+        rate_hz: float = 20.0,
+        camera_rate_hz: float = 2.0,
+    ) -> None:
+        self.node = node
+        self.sim_thread = sim_thread
+        self.pois = pois
+        self.activity = activity  # -> (state or "", detail)
+        self.latest: RobotSnapshot | None = None
+        # Wide enough to cover the marker-guided final approach (the base works ~12 cm closer to
+        # the table than the station's POI) plus navigation error; POIs lie metres apart.
+        self.poi_tolerance_m = 0.25
+        self.poi_yaw_tolerance_rad = 0.15
+        reliable = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
+        self.clock_pub = node.create_publisher(Clock, "/clock", reliable)
+        self.odom_pub = node.create_publisher(Odometry, "/odom", reliable)
+        self.joint_pub = node.create_publisher(JointState, "/joint_states", reliable)
+        self.robot_state_pub = node.create_publisher(RobotState, "/robot_state", reliable)
+        self.station_pub = node.create_publisher(StationStates, "/station_states", reliable)
+        # Simulator truth, like Gazebo's ground-truth plugins: for benchmarks, never for the robot.
+        self.truth_pub = node.create_publisher(Pose2D, "/ground_truth/base_pose", reliable)
+        self.image_pub = node.create_publisher(Image, CAMERA_IMAGE_TOPIC, 2)
+        self.info_pub = node.create_publisher(CameraInfo, CAMERA_INFO_TOPIC, 2)
+        self._last_robot_key: tuple | None = None
+        self._last_nests: tuple | None = None
+        self._last_slow_publish = 0.0
+        self._pending: Any = None
+        self._camera_pending: Any = None
+        self._previous_odometry: tuple[float, tuple[float, float, float]] | None = None
+        node.create_timer(1.0 / rate_hz, self._tick)
+        node.create_timer(1.0 / camera_rate_hz, self._camera_tick)
+
+    # -- sensors -> topics ---------------------------------------------------------------
+    def _tick(self) -> None:
+        if self._pending is not None and not self._pending.done():
+            return  # the sim thread is still answering the previous request
+        if self._pending is not None and self._pending.exception() is None:
+            self._publish(self._pending.result())
+        self._pending = self.sim_thread.call(self._snapshot_with_activity)
+
+    def _snapshot_with_activity(self, sim: Any) -> RobotSnapshot:
+        """Sensors and activity read at the same instant (on the sim thread): a state read later
+        than the pose said "idle" beside the pose of a base still braking (10 cm off, under load)."""
+        return replace(take_snapshot(sim), activity=self.activity())
+
+    def _publish(self, snapshot: RobotSnapshot) -> None:
+        self.latest = snapshot
+        stamp = stamp_of(snapshot.sim_time)
+        self.clock_pub.publish(Clock(clock=stamp))
+        self._publish_odometry(snapshot, stamp)
+        joints = JointState()
+        joints.header.stamp = stamp
+        joints.name = list(snapshot.joint_positions)
+        joints.position = [float(v) for v in snapshot.joint_positions.values()]
+        self.joint_pub.publish(joints)
+        state = self.robot_state(snapshot)
+        key = (
+            state.state,
+            state.detail,
+            state.current_poi,
+            tuple(h.labware_id for h in state.hotel),
+            state.held_labware_id,
+        )
+        now = time.monotonic()
+        slow_due = now - self._last_slow_publish >= 0.5
+        if key != self._last_robot_key or slow_due:
+            self.robot_state_pub.publish(state)
+            self._last_robot_key = key
+        # A nest that fills or empties is news too: the sequencer checks the source nest from this
+        # topic, and a GetLabware sent right after a place must not read the nest as still empty.
+        nests = tuple(snapshot.nests)
+        if nests != self._last_nests or slow_due:
+            self.station_pub.publish(self.station_states(snapshot))
+            if nests != self._last_nests:
+                log.info("nests at sim %.3f s: %s", snapshot.sim_time, _occupied_nests(nests))
+            self._last_nests = nests
+        if slow_due:
+            self._last_slow_publish = now
+            if snapshot.true_base_pose is not None:
+                x, y, yaw = snapshot.true_base_pose
+                self.truth_pub.publish(Pose2D(x=x, y=y, theta=yaw))
+
+    def _publish_odometry(self, snapshot: RobotSnapshot, stamp: Time) -> None:
+        x, y, yaw = snapshot.odometry
+        odom = Odometry()
+        odom.header.stamp = stamp
+        odom.header.frame_id = "odom"
+        odom.child_frame_id = "base_footprint"
+        odom.pose.pose.position.x, odom.pose.pose.position.y = x, y
+        odom.pose.pose.orientation.z = math.sin(yaw / 2.0)
+        odom.pose.pose.orientation.w = math.cos(yaw / 2.0)
+        if self._previous_odometry is not None:
+            previous_time, (px, py, pyaw) = self._previous_odometry
+            dt = snapshot.sim_time - previous_time
+            if dt > 1e-6:
+                vx_world, vy_world = (x - px) / dt, (y - py) / dt
+                odom.twist.twist.linear.x = math.cos(yaw) * vx_world + math.sin(yaw) * vy_world
+                odom.twist.twist.linear.y = -math.sin(yaw) * vx_world + math.cos(yaw) * vy_world
+                odom.twist.twist.angular.z = wrap_angle(yaw - pyaw) / dt
+        self._previous_odometry = (snapshot.sim_time, snapshot.odometry)
+        self.odom_pub.publish(odom)
+
+    def robot_state(self, snapshot: RobotSnapshot) -> RobotState:
+        activity, detail = snapshot.activity
+        message = RobotState()
+        message.stamp = stamp_of(snapshot.sim_time)
+        if activity:
+            message.state = activity
+        elif snapshot.docked:
+            message.state = RobotState.STATE_DOCKED
+        else:
+            message.state = RobotState.STATE_IDLE
+        message.detail = detail
+        message.current_poi = poi_at(
+            snapshot.odometry, self.pois(), self.poi_tolerance_m, self.poi_yaw_tolerance_rad
+        )
+        x, y, yaw = snapshot.odometry
+        message.base_pose = Pose2D(x=x, y=y, theta=yaw)
+        message.hotel = [
+            HotelSlot(index=int(index), labware_id=labware_id, labware_type=labware_type)
+            for index, labware_id, labware_type in snapshot.hotel
+        ]
+        message.held_labware_id = snapshot.held_labware_id
+        return message
+
+    @staticmethod
+    def station_states(snapshot: RobotSnapshot) -> StationStates:
+        return StationStates(
+            nests=[
+                NestState(
+                    station=station, sub_position=int(sub), occupied=bool(occupied), labware_id=labware_id
+                )
+                for station, sub, occupied, labware_id in snapshot.nests
+            ]
+        )
+
+    # -- head camera -------------------------------------------------------------------
+    def _camera_tick(self) -> None:
+        if self.image_pub.get_subscription_count() == 0 and self.info_pub.get_subscription_count() == 0:
+            return
+        if self._camera_pending is not None and not self._camera_pending.done():
+            return
+        if self._camera_pending is not None and self._camera_pending.exception() is None:
+            self._publish_camera(*self._camera_pending.result())
+        self._camera_pending = self.sim_thread.call(
+            lambda sim: (float(sim.sim_time), *sim.render_head_camera())
+        )
+
+    def _publish_camera(self, sim_time: float, rgb: Any, _depth: Any, intrinsics: Any) -> None:
+        stamp = stamp_of(sim_time)
+        image = Image()
+        image.header.stamp = stamp
+        image.header.frame_id = CAMERA_FRAME
+        image.height, image.width = int(rgb.shape[0]), int(rgb.shape[1])
+        image.encoding = "rgb8"
+        image.step = image.width * 3
+        image.data = rgb.tobytes()
+        self.image_pub.publish(image)
+        info = CameraInfo()
+        info.header = image.header
+        info.height, info.width = image.height, image.width
+        info.distortion_model = "plumb_bob"
+        info.d = [0.0] * 5
+        fx, fy, cx, cy = (
+            float(intrinsics.fx),
+            float(intrinsics.fy),
+            float(intrinsics.cx),
+            float(intrinsics.cy),
+        )
+        info.k = [fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0]
+        info.r = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
+        info.p = [fx, 0.0, cx, 0.0, 0.0, fy, cy, 0.0, 0.0, 0.0, 1.0, 0.0]
+        self.info_pub.publish(info)
