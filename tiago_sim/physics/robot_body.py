@@ -80,6 +80,20 @@ class RobotBody:
         self._track_groups: dict[tuple[str, ...], tuple] = {}
         self.frame_offsets = _fixed_frame_offsets()
 
+    def reset_posture(self, torso_lift: float, arm_positions: tuple[float, ...]) -> None:
+        """Initial configuration before any physics step: both arms at ``arm_positions`` (right-arm
+        joint order; the left arm mirrors it), fingers open, head level, torso at ``torso_lift``;
+        the motors hold it."""
+        posture = {"torso_lift_joint": torso_lift}
+        for side in robot_model.ARM_SIDES:
+            posture.update(dict(zip(robot_model.arm_joint_names(side), arm_positions, strict=True)))
+            posture.update({name: robot_model.FINGER_TRAVEL for name in robot_model.finger_joint_names(side)})
+        for name, value in posture.items():
+            p.resetJointState(self.id, self.joint_index[name], value, physicsClientId=self.client)
+        hold = {n: v for n, v in posture.items() if "finger" not in n}
+        hold.update({"head_1_joint": 0.0, "head_2_joint": 0.0})
+        self.command_positions(hold)
+
     def set_base_target(self, x: float, y: float, yaw: float) -> None:
         quat = [0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)]
         p.changeConstraint(

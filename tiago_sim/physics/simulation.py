@@ -12,13 +12,10 @@ from __future__ import annotations
 import logging
 import math
 import time
-from dataclasses import dataclass
 
 import numpy as np
-import pinocchio as pin
 import pybullet as p
 
-from tiago_sim import transforms as tf
 from tiago_sim.lab.world import World
 from tiago_sim.perception.camera import CameraIntrinsics, render_rgbd
 from tiago_sim.physics.arm_controller import JointTrajectoryMotion
@@ -26,8 +23,11 @@ from tiago_sim.physics.base_controller import DiffDriveBase, DriveMotion
 from tiago_sim.physics.gripper_controller import Gripper, GripperMotion
 from tiago_sim.physics.hotel_clamp import HotelClamp
 from tiago_sim.physics.motion import BUSY, CompletedMotion, FailedMotion, Motion, SequenceMotion
+from tiago_sim.physics.plate_sensing import PlacementCheck, PlateSensing
 from tiago_sim.physics.robot_body import RobotBody
-from tiago_sim.physics.scene import build_scene, plate_bottom_pose
+from tiago_sim.physics.scene import build_scene
+from tiago_sim.physics.step_ledger import StepLedger
+from tiago_sim.physics.tool_path import STRAIGHT_STEP, plan_tool_path
 from tiago_sim.robot import robot_model as rm
 from tiago_sim.robot.kinematics import RobotKinematics
 
@@ -67,55 +67,9 @@ DOCK_SENSOR_RANGE = 0.004  # m: the charging contacts close within this distance
 DOCK_SPEED = 0.05  # m/s backing onto the dock: stops within 3 mm once the contacts close
 DOCK_OVERTRAVEL = 0.08  # m: the reverse drive aims this far past the docked pose, contact ends it
 TOOL_SPEED = 0.08  # m/s along straight tool moves unless the caller asks otherwise
-STRAIGHT_STEP = 0.01  # m between IK waypoints
-MAX_WAYPOINT_JUMP = 0.25  # rad between consecutive IK waypoints
-# A delivered plate rests in its nest when it is within the nest's clearance + this per axis and
-# under the other limits (the success check of every transfer).
-PLACED_BEYOND_CLEARANCE_MM = 1.0
-PLACED_HEIGHT_TOLERANCE_MM = 2.0
-PLACED_YAW_TOLERANCE_DEG = 2.0
-PLACED_TILT_TOLERANCE_DEG = 1.0
-NEST_SENSOR_RANGE = 0.02  # m: presence sensor sees a plate whose centre is this close to the site
-
 # Arms folded beside the torso (PAL's "home"), head level.
 HOME_ARM = (0.2, -1.1, -0.2, 1.94, -1.57, 1.37, 0.0)
 HOME_TORSO = 0.15
-
-
-@dataclass(frozen=True)
-class PlacementCheck:
-    """Ground truth about one plate (CheckPlacement service)."""
-
-    found: bool
-    in_nest: bool
-    position_error_m: float
-    yaw_error_rad: float
-    location: str
-    outside: str = ""  # in the expected nest but not in_nest: every limit it missed
-
-
-class StepLedger:
-    """Physics steps and the CPU they took, by step length and solver iterations.
-
-    Why: the physics step is most of the sim thread's CPU; which regime eats it tells where a
-    faster simulation has to come from (logged when the sim thread stops)."""
-
-    def __init__(self) -> None:
-        self.entries: dict[tuple[float, int], list[float]] = {}  # -> [steps, sim s, CPU s]
-
-    def record(self, step_s: float, iterations: int, cpu_s: float) -> None:
-        entry = self.entries.setdefault((step_s, iterations), [0, 0.0, 0.0])
-        entry[0] += 1
-        entry[1] += step_s
-        entry[2] += cpu_s
-
-    def summary(self) -> str:
-        rows = sorted(self.entries.items(), key=lambda item: -item[1][2])
-        return "; ".join(
-            f"1/{round(1 / step_s)} s x {iterations} iterations: {int(steps)} steps, "
-            f"{sim_s:.1f} s simulated, {cpu_s:.2f} s CPU ({cpu_s / steps * 1000:.2f} ms/step)"
-            for (step_s, iterations), (steps, sim_s, cpu_s) in rows
-        )
 
 
 class Simulation:
@@ -130,8 +84,6 @@ class Simulation:
         odometry_noise: float = 0.0005,
     ) -> None:
         self.world = world
-        self._nest_sites_of: World | None = None
-        self._nest_sites_cache: list[tuple[str, int, np.ndarray]] = []
         self.time_step = time_step
         self.sim_time = 0.0
         self.rng = np.random.default_rng(seed)
@@ -145,7 +97,7 @@ class Simulation:
             physicsClientId=c,
         )
         self.robot = RobotBody(c, world.dock_pose.matrix())
-        self._reset_posture()
+        self.robot.reset_posture(HOME_TORSO, HOME_ARM)
         self.T_world_slot_at_start = {
             i: self.robot.link_pose(f"hotel_slot_{i}") for i in range(1, world.hotel_slots + 1)
         }
@@ -169,25 +121,12 @@ class Simulation:
         self._step = time_step
         self.last_step_s = time_step  # length of the latest physics step (s)
         self.step_ledger = StepLedger()
+        self.plate_sensing = PlateSensing(c, world, self.robot, self.scene, self.grippers)
         self._reviewed_at = -1.0
         self._plate_within_range = True
         self._turning_loaded = False
         for _ in range(int(0.5 / time_step)):  # let plates settle in their nests
             self.step()
-
-    def _reset_posture(self) -> None:
-        """Initial configuration (before any physics step): arms home, torso down a little."""
-        posture = {"torso_lift_joint": HOME_TORSO}
-        for side in rm.ARM_SIDES:
-            posture.update(dict(zip(rm.arm_joint_names(side), HOME_ARM, strict=True)))
-            posture.update({name: rm.FINGER_TRAVEL for name in rm.finger_joint_names(side)})
-        for name, value in posture.items():
-            p.resetJointState(
-                self.robot.id, self.robot.joint_index[name], value, physicsClientId=self.client_id
-            )
-        hold = {n: v for n, v in posture.items() if "finger" not in n}
-        hold.update({"head_1_joint": 0.0, "head_2_joint": 0.0})
-        self.robot.command_positions(hold)
 
     def close(self) -> None:
         if p.isConnected(self.client_id):
@@ -325,59 +264,17 @@ class Simulation:
         rgb, depth = render_rgbd(self.client_id, T_world_optical, intrinsics, supersample=supersample)
         return rgb, depth, intrinsics
 
-    def _plate_bottom(self, labware_id: str) -> np.ndarray:
-        body = self.scene.plates[labware_id]
-        return plate_bottom_pose(self.client_id, body, self.scene.plate_types[labware_id])
-
-    def _site_offset(self, T_world_site: np.ndarray, labware_id: str) -> np.ndarray:
-        return tf.invert(T_world_site) @ self._plate_bottom(labware_id)
-
-    def _plate_bottom_points(self) -> list[tuple[str, np.ndarray]]:
-        """World position of every plate's bottom centre (one query per plate, shared by all sensors)."""
-        points = []
-        for labware_id, body in self.scene.plates.items():
-            position, quat = p.getBasePositionAndOrientation(body, physicsClientId=self.client_id)
-            up = np.array(p.getMatrixFromQuaternion(quat)[2::3])  # the plate's z axis
-            half_height = self.scene.plate_types[labware_id].height / 2
-            points.append((labware_id, np.asarray(position) - half_height * up))
-        return points
-
-    @staticmethod
-    def _plate_near(T_world_site: np.ndarray, bottoms: list[tuple[str, np.ndarray]]) -> str:
-        """The plate whose bottom centre the presence sensor of this site sees, or ""."""
-        for labware_id, point in bottoms:
-            offset = T_world_site[:3, :3].T @ (point - T_world_site[:3, 3])
-            if math.hypot(offset[0], offset[1]) < NEST_SENSOR_RANGE and abs(offset[2]) < 0.01:
-                return labware_id
-        return ""
-
-    def _nest_sites(self) -> list[tuple[str, int, np.ndarray]]:
-        """(station, sub-position, T_world_site) of every nest; the stations never move, so cached."""
-        if self._nest_sites_of is not self.world:
-            self._nest_sites_cache = [
-                (station.name, sub, station.T_world_site(sub))
-                for station in self.world.stations
-                for sub in range(1, station.sub_positions + 1)
-            ]
-            self._nest_sites_of = self.world
-        return self._nest_sites_cache
-
     def nest_occupancy(self) -> list[tuple[str, int, bool, str]]:
-        bottoms = self._plate_bottom_points()
-        result = []
-        for name, sub, T_world_site in self._nest_sites():
-            labware_id = self._plate_near(T_world_site, bottoms)
-            result.append((name, sub, bool(labware_id), labware_id))
-        return result
+        """(station, sub-position, occupied, labware id) per nest, as each nest's presence sensor sees it."""
+        return self.plate_sensing.nest_occupancy()
 
     def hotel_occupancy(self) -> list[tuple[int, str, str]]:
-        bottoms = self._plate_bottom_points()
-        result = []
-        for slot in range(1, self.world.hotel_slots + 1):
-            labware_id = self._plate_near(self.robot.link_pose(f"hotel_slot_{slot}"), bottoms)
-            labware_type = self.scene.plate_types[labware_id].name if labware_id else ""
-            result.append((slot, labware_id, labware_type))
-        return result
+        """(slot, labware id, labware type) per hotel pocket, as its presence sensor sees it."""
+        return self.plate_sensing.hotel_occupancy()
+
+    def plate_bottom_pose(self, labware_id: str) -> np.ndarray:
+        """T_world_bottom of a plate (its bottom face centre): physics ground truth."""
+        return self.plate_sensing.plate_bottom(labware_id)
 
     def held_labware(self, arm: str) -> str:
         """Plate between that gripper's pads (both touching), or the one attached after a verified grasp."""
@@ -466,58 +363,18 @@ class Simulation:
         """
         if arm not in rm.ARM_SIDES:
             return FailedMotion("move_tool", "BAD_GOAL", f"unknown arm {arm!r}")
-        current = self.joint_positions()
-        T_start = self.kinematics.forward(current, f"arm_{arm}_grasping_frame")
-        T_goal = np.asarray(T_base_grasp, dtype=float)
-        waypoints = _straight_path(T_start, T_goal) if straight_line else [T_goal]
-        solutions: list[dict[str, float]] = []
-        seed = dict(current)
-        for index, T_waypoint in enumerate(waypoints):
-            restarts = 30 if (index == 0 and not straight_line) else 3
-            result = self.kinematics.inverse(
-                arm,
-                T_waypoint,
-                seed,
-                use_torso=use_torso,
-                restarts=restarts,
-                seed=int(self.rng.integers(1 << 30)),
-            )
-            jump = max(
-                (abs(result.joint_positions[n] - seed[n]) for n in result.joint_positions), default=0.0
-            )
-            if straight_line and (not result.success or jump > MAX_WAYPOINT_JUMP):
-                # near a joint limit the seeded solve can stall: creep there in small, seeded steps
-                T_previous = waypoints[index - 1] if index else T_start
-                result = self._creep(arm, T_previous, T_waypoint, seed, use_torso) or result
-                jump = max(
-                    (abs(result.joint_positions[n] - seed[n]) for n in result.joint_positions), default=0.0
-                )
-            if not result.success or (straight_line and jump > MAX_WAYPOINT_JUMP):
-                why = "unreachable" if not result.success else f"joint jump {jump:.2f} rad"
-                return FailedMotion("move_tool", "IK_FAILED", f"waypoint {index + 1}/{len(waypoints)} {why}")
-            solutions.append(result.joint_positions)
-            seed.update(result.joint_positions)
+        planned = plan_tool_path(
+            self.kinematics, self.rng, arm, self.joint_positions(), T_base_grasp, straight_line, use_torso
+        )
+        if isinstance(planned, str):
+            return FailedMotion("move_tool", "IK_FAILED", planned)
+        solutions = planned
         segment_s = STRAIGHT_STEP / max(tool_speed, 1e-3) if straight_line else 0.0
         resources = frozenset({f"arm_{arm}", "torso"})
         motion = JointTrajectoryMotion(
             self.robot, solutions, 1.0, name="move_tool", min_segment_s=segment_s, resources=resources
         )
         return self._start(motion)
-
-    def _creep(
-        self, arm: str, T_from: np.ndarray, T_to: np.ndarray, seed: dict[str, float], use_torso: bool = True
-    ):
-        """IK for T_to reached from T_from in seeded sub-steps (no random restarts), or None."""
-        here = dict(seed)
-        result = None
-        for T_sub in _straight_path(T_from, T_to, step=STRAIGHT_STEP / 5):
-            result = self.kinematics.inverse(
-                arm, T_sub, here, use_torso=use_torso, restarts=0, max_iterations=400
-            )
-            if not result.success:
-                return None
-            here.update(result.joint_positions)
-        return result
 
     def gripper(self, arm: str, close: bool) -> Motion:
         if arm not in rm.ARM_SIDES:
@@ -526,67 +383,6 @@ class Simulation:
 
     # ----------------------------------------------------------------- ground truth
     def check_placement(self, labware_id: str, station: str, sub_position: int) -> PlacementCheck:
-        if labware_id not in self.scene.plates:
-            return PlacementCheck(False, False, math.inf, math.inf, "unknown")
-        location = self._locate(labware_id)
-        if not station:
-            return PlacementCheck(True, False, math.nan, math.nan, location)
-        site = self.world.station(station)
-        offset = self._site_offset(site.T_world_site(sub_position), labware_id)
-        position_error = float(np.linalg.norm(offset[:2, 3]))
-        yaw_error = abs(tf.wrap_angle(tf.yaw_of(offset)))
-        tilt = tf.rotation_angle(np.eye(3), offset[:3, :3]) - yaw_error
-        margin_mm = 1000.0 * site.nest_clearance + PLACED_BEYOND_CLEARANCE_MM
-        x_mm, y_mm, z_mm = (1000.0 * float(v) for v in offset[:3, 3])
-        missed = [
-            f"{label} {value:.1f} {unit} (limit {limit:.1f})"
-            for label, value, unit, limit in (
-                ("off along the nest's long side by", abs(x_mm), "mm", margin_mm),
-                ("off across the nest by", abs(y_mm), "mm", margin_mm),
-                ("raised" if z_mm > 0 else "sunk", abs(z_mm), "mm", PLACED_HEIGHT_TOLERANCE_MM),
-                ("turned", math.degrees(yaw_error), "deg", PLACED_YAW_TOLERANCE_DEG),
-                ("tilted", abs(math.degrees(tilt)), "deg", PLACED_TILT_TOLERANCE_DEG),
-            )
-            if value >= limit
-        ]
-        outside = ", ".join(missed)
-        return PlacementCheck(True, not missed, position_error, float(yaw_error), location, outside)
-
-    def _locate(self, labware_id: str) -> str:
-        for _side, gripper in self.grippers.items():
-            if gripper.attached_id == labware_id or gripper.touching() == labware_id:
-                return "gripper"
-        for name, sub, _, found in self.nest_occupancy():
-            if found == labware_id:
-                return f"station:{name}:{sub}"
-        for slot, found, _ in self.hotel_occupancy():
-            if found == labware_id:
-                return f"hotel:{slot}"
-        if self._plate_bottom(labware_id)[2, 3] < 0.05:
-            return "floor"
-        return "unknown"
-
-
-def _straight_path(T_start: np.ndarray, T_goal: np.ndarray, step: float = STRAIGHT_STEP) -> list[np.ndarray]:
-    """Poses along the straight line (and the shortest rotation) from start to goal, goal last."""
-    distance = float(np.linalg.norm(T_goal[:3, 3] - T_start[:3, 3]))
-    angle = tf.rotation_angle(T_start[:3, :3], T_goal[:3, :3])
-    count = max(1, math.ceil(distance / step), math.ceil(angle / (5 * step)))
-    relative = T_start[:3, :3].T @ T_goal[:3, :3]
-    axis_angle = _log_rotation(relative)
-    poses = []
-    for i in range(1, count + 1):
-        s = i / count
-        pose = np.eye(4)
-        pose[:3, 3] = T_start[:3, 3] + s * (T_goal[:3, 3] - T_start[:3, 3])
-        pose[:3, :3] = T_start[:3, :3] @ _exp_rotation(s * axis_angle)
-        poses.append(pose)
-    return poses
-
-
-def _log_rotation(rotation: np.ndarray) -> np.ndarray:
-    return np.asarray(pin.log3(rotation))
-
-
-def _exp_rotation(vector: np.ndarray) -> np.ndarray:
-    return np.asarray(pin.exp3(vector))
+        """Where a plate really is, and whether it rests in that nest within tolerance (success
+        checks only, never robot control)."""
+        return self.plate_sensing.check_placement(labware_id, station, sub_position)

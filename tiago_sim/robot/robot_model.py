@@ -28,6 +28,7 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
+from tiago_sim.robot.hotel_model import add_hotel
 from tiago_sim.robot.urdf_writer import UrdfWriter
 
 ARM_SIDES = ("right", "left")
@@ -55,13 +56,6 @@ PAD_WIDTH = 0.080  # along grasping-frame z (along the plate's long side)
 PAD_TIP = 0.005  # pad reaches this far past the grasping frame along x
 PAD_LENGTH = 0.035  # along grasping-frame x
 TOOL_TO_GRASP = 0.1506 + 0.12
-
-# Hotel (onboard plate holder): pocket floors on the base front, reachable top-down by either arm
-HOTEL_SLOT_XYZ = ((0.25, -0.07, 0.60), (0.25, 0.07, 0.60))
-HOTEL_POCKET_SIZE = (0.1318, 0.0895)  # inner length x width, 2 mm clearance per side
-HOTEL_WALL_HEIGHT = 0.004  # vertical part at the pocket edge; the lead-in chamfer sits on top (rim 10 mm)
-HOTEL_LEAD_IN = 0.006  # per side, 45 deg chamfers on the corner posts: a plate carried a few mm off
-# centre in the gripper slides into the pocket instead of resting on a post (seed 102 of the campaign)
 
 
 @dataclass(frozen=True)
@@ -320,83 +314,6 @@ def _add_gripper(w: UrdfWriter, side: str, tool: str) -> None:
     )
 
 
-def corner_bracket_boxes(length: float, width: float, height: float, leg: float = 0.015, wall: float = 0.006):
-    """Boxes (size, centre) of four L-brackets framing a pocket of inner size length x width.
-
-    The brackets hold only the corners, so the middle of each long side stays free for finger pads.
-    """
-    boxes = []
-    for cx in (-1, 1):
-        for cy in (-1, 1):
-            x_edge = cx * (length / 2 + wall / 2)
-            y_edge = cy * (width / 2 + wall / 2)
-            boxes.append(
-                ((wall, leg + wall, height), (x_edge, cy * (width / 2 - leg / 2 + wall / 2), height / 2))
-            )
-            boxes.append(((leg, wall, height), (cx * (length / 2 - leg / 2), y_edge, height / 2)))
-    return boxes
-
-
-def _corner_brackets(x: float, y: float, z: float, length: float, width: float):
-    return [
-        ("box", size, (x + cx, y + cy, z + cz), (0, 0, 0), "dark")
-        for size, (cx, cy, cz) in corner_bracket_boxes(length, width, HOTEL_WALL_HEIGHT)
-    ] + _lead_ins(x, y, z, length, width)
-
-
-def _lead_ins(
-    x: float, y: float, z: float, length: float, width: float, leg: float = 0.015, wall: float = 0.006
-):
-    """45 deg chamfer plates on top of the corner posts, widening the opening by HOTEL_LEAD_IN per side."""
-    lead, thick, top = HOTEL_LEAD_IN, 0.003, z + HOTEL_WALL_HEIGHT
-    slope = lead * math.sqrt(2.0)
-    inset = thick / 2 / math.sqrt(2.0)  # the plate's lower face meets the wall's top edge
-    shapes = []
-    for cx in (-1, 1):
-        for cy in (-1, 1):
-            across = (x + cx * (length / 2 + lead / 2 + inset), y + cy * (width / 2 - leg / 2 + wall / 2))
-            shapes.append(
-                ("box", (slope, leg + wall, thick), (*across, top + lead / 2 - inset),
-                 (0, -math.pi / 4 if cx > 0 else -3 * math.pi / 4, 0), "dark")
-            )  # fmt: skip
-            along = (x + cx * (length / 2 - leg / 2), y + cy * (width / 2 + lead / 2 + inset))
-            shapes.append(
-                ("box", (leg, slope, thick), (*along, top + lead / 2 - inset),
-                 (math.pi / 4 if cy > 0 else 3 * math.pi / 4, 0, 0), "dark")
-            )  # fmt: skip
-    return shapes
-
-
-def _add_hotel(w: UrdfWriter) -> None:
-    """A post-mounted tray with one pocket (floor + four corner L-posts) per slot."""
-    length, width = HOTEL_POCKET_SIZE
-    shapes = []
-    for x, y, z in HOTEL_SLOT_XYZ:
-        shapes.append(
-            ("box", (length + 0.03, width + 0.02, 0.01), (x, y, z - 0.005 - WHEEL_RADIUS), (0, 0, 0), "grey")
-        )
-        shapes.extend(_corner_brackets(x, y, z - WHEEL_RADIUS, length, width))
-    post_top = HOTEL_SLOT_XYZ[0][2] - 0.01 - WHEEL_RADIUS
-    base_top = 0.297 - WHEEL_RADIUS
-    post_height = post_top - base_top
-    shapes.append(
-        (
-            "box",
-            (0.04, 0.06, post_height),
-            (HOTEL_SLOT_XYZ[0][0], 0, base_top + post_height / 2),
-            (0, 0, 0),
-            "grey",
-        )
-    )
-    w.link("hotel_link", 1.5, shapes)
-    w.joint("hotel_joint", "fixed", "base_link", "hotel_link")
-    for index, (x, y, z) in enumerate(HOTEL_SLOT_XYZ, start=1):
-        w.link(f"hotel_slot_{index}")
-        w.joint(
-            f"hotel_slot_{index}_joint", "fixed", "base_link", f"hotel_slot_{index}", (x, y, z - WHEEL_RADIUS)
-        )
-
-
 def build_urdf() -> str:
     """URDF text of the whole robot."""
     writer = UrdfWriter("tiago_dual_sim")
@@ -404,7 +321,7 @@ def build_urdf() -> str:
     _add_torso_and_head(writer)
     for side in ARM_SIDES:
         _add_arm(writer, side)
-    _add_hotel(writer)
+    add_hotel(writer, WHEEL_RADIUS)
     return writer.text()
 
 

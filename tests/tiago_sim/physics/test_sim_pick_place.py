@@ -44,7 +44,7 @@ class Script:
         return top_down_grasp(position, tf.yaw_of(T_base_site))
 
     def plate_in_base(self) -> np.ndarray:
-        return tf.invert(self.sim.robot.base_pose()) @ self.sim._plate_bottom(PLATE)
+        return tf.invert(self.sim.robot.base_pose()) @ self.sim.plate_bottom_pose(PLATE)
 
     def plate_in_grasp(self) -> np.ndarray:
         T_base_grasp = self.sim.kinematics.forward(self.sim.joint_positions(), f"arm_{ARM}_grasping_frame")

@@ -30,7 +30,7 @@ def _put_plate_in_hotel(sim: Simulation, slot: int) -> None:
 
 
 def _plate_in_base(sim: Simulation) -> np.ndarray:
-    return tf.invert(sim.robot.base_pose()) @ sim._plate_bottom(PLATE)
+    return tf.invert(sim.robot.base_pose()) @ sim.plate_bottom_pose(PLATE)
 
 
 def test_driving_takes_long_steps_and_a_gripper_motion_short_ones():

@@ -1,0 +1,149 @@
+"""The plate sensors of the lab and the robot, and the physics' own judgement of a delivery.
+
+Why together: both read where plates rest from PyBullet. The presence sensors (one per nest, one
+per hotel pocket) report what a real sensor could (a plate there, and which one: see the README's
+modelling notes); ``check_placement`` is ground truth and serves success checks only, never robot
+control. Lives on the sim thread.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import pybullet as p
+
+from tiago_sim import transforms as tf
+from tiago_sim.lab.world import World
+from tiago_sim.physics.robot_body import RobotBody
+from tiago_sim.physics.scene import plate_bottom_pose
+
+# A delivered plate rests in its nest when it is within the nest's clearance + this per axis and
+# under the other limits (the success check of every transfer).
+PLACED_BEYOND_CLEARANCE_MM = 1.0
+PLACED_HEIGHT_TOLERANCE_MM = 2.0
+PLACED_YAW_TOLERANCE_DEG = 2.0
+PLACED_TILT_TOLERANCE_DEG = 1.0
+NEST_SENSOR_RANGE = 0.02  # m: presence sensor sees a plate whose centre is this close to the site
+
+
+@dataclass(frozen=True)
+class PlacementCheck:
+    """Ground truth about one plate (CheckPlacement service)."""
+
+    found: bool
+    in_nest: bool
+    position_error_m: float
+    yaw_error_rad: float
+    location: str
+    outside: str = ""  # in the expected nest but not in_nest: every limit it missed
+
+
+class PlateSensing:
+    """Presence sensors and the placement check over one scene (see the module docstring)."""
+
+    def __init__(
+        self, client_id: int, world: World, robot: RobotBody, scene: Any, grippers: dict[str, Any]
+    ) -> None:
+        self._client_id = client_id
+        self._world = world
+        self._robot = robot
+        self._scene = scene
+        self._grippers = grippers
+        self._nest_sites_cache: list[tuple[str, int, np.ndarray]] | None = None
+
+    def plate_bottom(self, labware_id: str) -> np.ndarray:
+        body = self._scene.plates[labware_id]
+        return plate_bottom_pose(self._client_id, body, self._scene.plate_types[labware_id])
+
+    def _site_offset(self, T_world_site: np.ndarray, labware_id: str) -> np.ndarray:
+        return tf.invert(T_world_site) @ self.plate_bottom(labware_id)
+
+    def _plate_bottom_points(self) -> list[tuple[str, np.ndarray]]:
+        """World position of every plate's bottom centre (one query per plate, shared by all sensors)."""
+        points = []
+        for labware_id, body in self._scene.plates.items():
+            position, quat = p.getBasePositionAndOrientation(body, physicsClientId=self._client_id)
+            up = np.array(p.getMatrixFromQuaternion(quat)[2::3])  # the plate's z axis
+            half_height = self._scene.plate_types[labware_id].height / 2
+            points.append((labware_id, np.asarray(position) - half_height * up))
+        return points
+
+    @staticmethod
+    def _plate_near(T_world_site: np.ndarray, bottoms: list[tuple[str, np.ndarray]]) -> str:
+        """The plate whose bottom centre the presence sensor of this site sees, or ""."""
+        for labware_id, point in bottoms:
+            offset = T_world_site[:3, :3].T @ (point - T_world_site[:3, 3])
+            if math.hypot(offset[0], offset[1]) < NEST_SENSOR_RANGE and abs(offset[2]) < 0.01:
+                return labware_id
+        return ""
+
+    def _nest_sites(self) -> list[tuple[str, int, np.ndarray]]:
+        """(station, sub-position, T_world_site) of every nest; the stations never move, so computed once."""
+        if self._nest_sites_cache is None:
+            self._nest_sites_cache = [
+                (station.name, sub, station.T_world_site(sub))
+                for station in self._world.stations
+                for sub in range(1, station.sub_positions + 1)
+            ]
+        return self._nest_sites_cache
+
+    def nest_occupancy(self) -> list[tuple[str, int, bool, str]]:
+        bottoms = self._plate_bottom_points()
+        result = []
+        for name, sub, T_world_site in self._nest_sites():
+            labware_id = self._plate_near(T_world_site, bottoms)
+            result.append((name, sub, bool(labware_id), labware_id))
+        return result
+
+    def hotel_occupancy(self) -> list[tuple[int, str, str]]:
+        bottoms = self._plate_bottom_points()
+        result = []
+        for slot in range(1, self._world.hotel_slots + 1):
+            labware_id = self._plate_near(self._robot.link_pose(f"hotel_slot_{slot}"), bottoms)
+            labware_type = self._scene.plate_types[labware_id].name if labware_id else ""
+            result.append((slot, labware_id, labware_type))
+        return result
+
+    def check_placement(self, labware_id: str, station: str, sub_position: int) -> PlacementCheck:
+        if labware_id not in self._scene.plates:
+            return PlacementCheck(False, False, math.inf, math.inf, "unknown")
+        location = self._locate(labware_id)
+        if not station:
+            return PlacementCheck(True, False, math.nan, math.nan, location)
+        site = self._world.station(station)
+        offset = self._site_offset(site.T_world_site(sub_position), labware_id)
+        position_error = float(np.linalg.norm(offset[:2, 3]))
+        yaw_error = abs(tf.wrap_angle(tf.yaw_of(offset)))
+        tilt = tf.rotation_angle(np.eye(3), offset[:3, :3]) - yaw_error
+        margin_mm = 1000.0 * site.nest_clearance + PLACED_BEYOND_CLEARANCE_MM
+        x_mm, y_mm, z_mm = (1000.0 * float(v) for v in offset[:3, 3])
+        missed = [
+            f"{label} {value:.1f} {unit} (limit {limit:.1f})"
+            for label, value, unit, limit in (
+                ("off along the nest's long side by", abs(x_mm), "mm", margin_mm),
+                ("off across the nest by", abs(y_mm), "mm", margin_mm),
+                ("raised" if z_mm > 0 else "sunk", abs(z_mm), "mm", PLACED_HEIGHT_TOLERANCE_MM),
+                ("turned", math.degrees(yaw_error), "deg", PLACED_YAW_TOLERANCE_DEG),
+                ("tilted", abs(math.degrees(tilt)), "deg", PLACED_TILT_TOLERANCE_DEG),
+            )
+            if value >= limit
+        ]
+        outside = ", ".join(missed)
+        return PlacementCheck(True, not missed, position_error, float(yaw_error), location, outside)
+
+    def _locate(self, labware_id: str) -> str:
+        for _side, gripper in self._grippers.items():
+            if gripper.attached_id == labware_id or gripper.touching() == labware_id:
+                return "gripper"
+        for name, sub, _, found in self.nest_occupancy():
+            if found == labware_id:
+                return f"station:{name}:{sub}"
+        for slot, found, _ in self.hotel_occupancy():
+            if found == labware_id:
+                return f"hotel:{slot}"
+        if self.plate_bottom(labware_id)[2, 3] < 0.05:
+            return "floor"
+        return "unknown"
