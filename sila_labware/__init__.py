@@ -5,6 +5,7 @@ Layers, each a subpackage that imports only the ones listed before it:
   checks (`validation`), the inventory, the robot and station controllers, their errors;
 - `servers`: the SiLA servers generated from features/ (`robot_server`, `station_server`), the
   glue between sila2 and `device`, TLS, port checks and the standalone start-up;
-- `deployment`: what `sila-labware` runs: child processes, the supervisor, the CLI, the demo;
-- `benchmarks`: the repeatability campaign, its report and the bridge latency benchmark.
+- `deployment`: what `sila-labware` runs: child processes, the supervisor, the demo;
+- `benchmarks`: the repeatability campaign, its report and the bridge latency benchmark;
+- `cli`: the `sila-labware` command on top of all of them (`python -m sila_labware` runs it).
 """

@@ -68,7 +68,7 @@ def time_serve_until_discoverable(
     zeroconf = Zeroconf()
     listener = _PortListener()
     browser = ServiceBrowser(zeroconf, SILA_SERVICE_TYPE, listener)
-    command = [sys.executable, "-m", "sila_labware.deployment.cli", "serve", "--world", str(world)]
+    command = [sys.executable, "-m", "sila_labware.cli", "serve", "--world", str(world)]
     command += ["--port-base", str(port_base), "--ca-file", str(ca_file)]
     started = time.monotonic()
     serve = subprocess.Popen(

@@ -26,7 +26,7 @@ from tests.helpers.sila_stack import free_port_base
 from tiago_sim.lab.world import load_world
 from tiago_sim.measuring import disturbances
 
-CLI = [sys.executable, "-m", "sila_labware.deployment.cli"]
+CLI = [sys.executable, "-m", "sila_labware.cli"]
 SEED = 4242
 
 

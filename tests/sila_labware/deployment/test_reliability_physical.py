@@ -8,7 +8,7 @@ The faults come from tiago_sim.measuring.fault_injection.
   node's goal log unchanged);
 - plate slips out of the hotel mid-drive (physics drops it) -> PutLabware ends with LabwareNotPlaced,
   the inventory says "lost" (no sensor watches the floor; ground truth finds it there);
-- marker occluded -> LabwareNotPicked: tests/test_sila_servers.py
+- marker occluded -> LabwareNotPicked: tests/sila_labware/servers/test_sila_servers.py
   (test_failed_get_is_labware_not_picked_and_inventory_stays_true).
 
 The world is the default lab plus a second plate in station_b/2, the occupied destination.

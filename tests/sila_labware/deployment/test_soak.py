@@ -4,8 +4,9 @@ Why a subprocess and not `start_stack`: the question is whether the program a la
 leaks memory, threads, goals or subscriptions, so the test watches that program's processes from
 outside (/proc) and talks to it only as a scheduler would (SiLA over gRPC).
 
-Run apart from the quick suite: `pytest -m soak tests/test_soak.py -s` (the figures are printed
-and, with SOAK_REPORT=path, written as JSON). SOAK_TRANSFERS changes the count (default 50).
+Run apart from the quick suite: `pytest -m soak tests/sila_labware/deployment/test_soak.py -s`
+(the figures are printed and, with SOAK_REPORT=path, written as JSON). SOAK_TRANSFERS changes the
+count (default 50).
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ from ros_bridge.runtime import RosRuntime
 from tests.helpers.sila_stack import free_port_base
 from tests.helpers.transfer_steps import Cell
 
-CLI = [sys.executable, "-m", "sila_labware.deployment.cli"]
+CLI = [sys.executable, "-m", "sila_labware.cli"]
 TRANSFERS = int(os.environ.get("SOAK_TRANSFERS", "50"))
 PORT_BASES = range(51600, 51697)  # a block of 4 ports within 51600..51699
 PLATE = "plate_001"

@@ -28,7 +28,7 @@ from sila2.client import SilaClient
 from sila_labware.servers.tls import CertificateAuthority
 from tests.helpers.sila_stack import free_port_base
 
-CLI = [sys.executable, "-m", "sila_labware.deployment.cli"]
+CLI = [sys.executable, "-m", "sila_labware.cli"]
 CHOSEN_HOST = "127.0.0.2"  # a loopback address other than the default, so the test needs no network
 INSECURE_WARNING = "serving WITHOUT encryption (--insecure)"
 SERVER_NAME_METHOD = "/sila2.org.silastandard.core.silaservice.v1.SiLAService/Get_ServerName"

@@ -18,7 +18,7 @@ from sila2.client import SilaClient
 
 from tests.helpers.sila_stack import free_port_base
 
-CLI = [sys.executable, "-m", "sila_labware.deployment.cli"]
+CLI = [sys.executable, "-m", "sila_labware.cli"]
 
 
 def run_cli(*arguments: str, timeout_s: float = 30.0) -> subprocess.CompletedProcess:

@@ -15,7 +15,7 @@ import yaml
 
 from tests.helpers.sila_stack import DEFAULT_WORLD, free_port_base
 
-CLI = [sys.executable, "-m", "sila_labware.deployment.cli"]
+CLI = [sys.executable, "-m", "sila_labware.cli"]
 
 
 def bad_world(tmp_path: Path, mutate: Callable[[dict[str, Any]], None]) -> Path:
