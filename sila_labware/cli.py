@@ -35,7 +35,7 @@ if TYPE_CHECKING:
 
 logger = logging.getLogger("sila_labware")
 
-DEFAULT_WORLD = Path(__file__).resolve().parents[2] / "tiago_sim" / "worlds" / "default.yaml"
+DEFAULT_WORLD = Path(__file__).resolve().parents[1] / "tiago_sim" / "worlds" / "default.yaml"
 
 
 class _Parser(argparse.ArgumentParser):
