@@ -1,11 +1,17 @@
 """TLS for our SiLA servers: one private CA per deployment, one certificate per server.
 
 SiLA 2 requires encrypted connections outside tests. sila2 can make a self-signed certificate
-per server, but those all carry the same subject name: a client given several of them as roots
-picks the wrong one by name and the handshake fails. So a deployment makes its own small CA
-(kept in memory only), signs one certificate per server with it (with the server UUID in the
-SiLA extension, OID 1.3.6.1.4.1.58583, and the host's address as subject alternative name),
-and writes only the CA certificate to a file for clients.
+per server, but each is then its own root, and all carry the same subject name: a client given
+several of them as roots picks the wrong one by name and the handshake fails. So a deployment
+makes its own small CA (kept in memory only, with a name of its own), signs one certificate per
+server with it, and writes only the CA certificate to a file for clients.
+
+A server certificate is what SiLA 2 Part B asks of a server whose certificate does not come from
+a public authority: common name ``SiLA2``, the server UUID in the SiLA extension (OID
+1.3.6.1.4.1.58583), the CA announced in the discovery record (`serving` does that). A client that
+takes the CA from discovery alone checks that common name and connects; the host's addresses are
+subject alternative names, so TLS checks the address as usual. The server's own name stands in
+the organisational unit, for people reading the certificate.
 """
 
 from __future__ import annotations
@@ -13,6 +19,7 @@ from __future__ import annotations
 import datetime
 import ipaddress
 import logging
+import secrets
 import socket
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,13 +42,15 @@ class ServerCredentials:
     certificate_pem: bytes
 
 
-def _name(common_name: str) -> x509.Name:
-    return x509.Name(
-        [
-            x509.NameAttribute(NameOID.ORGANIZATION_NAME, "sila-labware deployment"),
-            x509.NameAttribute(NameOID.COMMON_NAME, common_name),
-        ]
-    )
+SILA_UNTRUSTED_COMMON_NAME = "SiLA2"
+"""The common name SiLA 2 Part B requires of a server certificate not issued by a public authority."""
+
+
+def _name(common_name: str, unit: str = "") -> x509.Name:
+    attributes = [x509.NameAttribute(NameOID.ORGANIZATION_NAME, "sila-labware deployment")]
+    if unit:
+        attributes.append(x509.NameAttribute(NameOID.ORGANIZATIONAL_UNIT_NAME, unit))
+    return x509.Name([*attributes, x509.NameAttribute(NameOID.COMMON_NAME, common_name)])
 
 
 def _machine_addresses() -> set[str]:
@@ -76,8 +85,11 @@ def _subject_alternative_names(host: str) -> list[x509.GeneralName]:
 class CertificateAuthority:
     """A throw-away CA: its key never leaves memory; its certificate is what clients trust."""
 
-    def __init__(self, common_name: str = "sila-labware CA") -> None:
+    def __init__(self, common_name: str = "") -> None:
+        """``common_name`` defaults to one unique to this CA, so that two labs' CAs differ by name
+        as well as by key (a client that trusts both finds the right one)."""
         self._key = ec.generate_private_key(ec.SECP256R1())
+        common_name = common_name or f"sila-labware CA {secrets.token_hex(4)}"
         now = datetime.datetime.now(datetime.timezone.utc)
         self._name = _name(common_name)
         self.certificate = (
@@ -117,7 +129,7 @@ class CertificateAuthority:
         now = datetime.datetime.now(datetime.timezone.utc)
         certificate = (
             x509.CertificateBuilder()
-            .subject_name(_name(server_name))
+            .subject_name(_name(SILA_UNTRUSTED_COMMON_NAME, unit=server_name))
             .issuer_name(self._name)
             .public_key(key.public_key())
             .serial_number(x509.random_serial_number())

@@ -190,3 +190,18 @@ def test_unitelabs_client_moves_the_plate_from_a_to_b(stack: Deployment) -> None
     assert placement.position_error_m < 0.005, placement
     nests = {(nest.station, nest.sub_position): nest.occupied for nest in stack.link.nest_occupancies()}
     assert nests[DESTINATION] and not nests[SOURCE]
+
+
+def test_sila2_discovery_without_a_ca_file_trusts_the_announced_ca(stack: Deployment) -> None:
+    """SiLA 2 Part B: a client given no root certificate takes the CA from the discovery record
+    and accepts the server because its certificate's common name is SiLA2."""
+    from sila2.client import SilaClient
+
+    served = stack.robot_server()
+    client = SilaClient.discover(server_uuid=served.server.server_uuid, timeout=20)
+    try:
+        assert client.SiLAService.ServerUUID.get() == str(served.server.server_uuid)
+        positions = client.LabwareTransferManipulatorController.AvailableHandoverPositions.get()
+        assert {position.Position for position in positions} == {"station_a", "station_b"}
+    finally:
+        client._channel.close()  # sila2 0.14 offers no public close

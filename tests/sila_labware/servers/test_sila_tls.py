@@ -10,6 +10,7 @@ import pytest
 from cryptography import x509
 from cryptography.exceptions import InvalidSignature
 from cryptography.hazmat.primitives.asymmetric import ec
+from cryptography.x509.oid import NameOID
 
 from sila_labware.servers.tls import SILA_SERVER_UUID_OID, CertificateAuthority
 
@@ -49,3 +50,19 @@ def test_each_deployment_has_its_own_ca() -> None:
         first.certificate.public_key().verify(
             leaf.signature, leaf.tbs_certificate_bytes, ec.ECDSA(leaf.signature_hash_algorithm)
         )
+
+
+def test_server_certificates_carry_the_common_name_sila_part_b_asks_of_untrusted_servers() -> None:
+    """A client that takes the CA from the discovery record refuses any other common name."""
+    authority = CertificateAuthority()
+    certificate = x509.load_pem_x509_certificate(
+        authority.issue_server_credentials(uuid.uuid4(), "Station station_a", "127.0.0.1").certificate_pem
+    )
+    assert [a.value for a in certificate.subject.get_attributes_for_oid(NameOID.COMMON_NAME)] == ["SiLA2"]
+    units = certificate.subject.get_attributes_for_oid(NameOID.ORGANIZATIONAL_UNIT_NAME)
+    assert [a.value for a in units] == ["Station station_a"]
+    ca_name, other_ca_name = (
+        ca.certificate.subject.get_attributes_for_oid(NameOID.COMMON_NAME)[0].value
+        for ca in (authority, CertificateAuthority())
+    )
+    assert ca_name.startswith("sila-labware CA ") and ca_name != other_ca_name
