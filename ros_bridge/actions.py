@@ -1,9 +1,13 @@
 """Call a ROS 2 action from any thread: send goal, watch feedback, wait for the result, cancel.
 
+`ActionCaller.send` returns an `ActionGoal` (ros_bridge.goal_status: the status contract every
+caller uses) and keeps, for each goal, a `_GoalOverRos` that is the goal's creator: it turns
+rclpy's answers (goal accepted, feedback, result) into the status's set_* calls and sends cancel
+requests.
+
 Threads: `ActionCaller` and `ActionGoal` are used from caller threads (SiLA handlers). Every
-rclpy call they make is handed to the ROS thread of a `RosRuntime`; what comes back (goal
-accepted, feedback, result) is stored in `concurrent.futures.Future`s and a lock-protected
-progress snapshot. Feedback listeners run on the ROS thread: keep them short.
+rclpy call is handed to the ROS thread of a `RosRuntime`; rclpy's answers arrive there, so the
+goal's progress listeners and completion callbacks run on the ROS thread: keep them short.
 
 Our actions share one feedback shape (progress 0..1, phase, remaining_time_s) and one result
 shape (success, error_code, message); other fields of the result stay reachable as `result`.
@@ -16,14 +20,15 @@ import logging
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any
 
 from action_msgs.msg import GoalStatus
 from rclpy.action import ActionClient
 from rclpy.action.client import ClientGoalHandle
 
-from ros_bridge.errors import BridgeError, BridgeTimeout, GoalRejected, ServerUnavailable
+from ros_bridge.errors import BridgeError, BridgeTimeout, ServerUnavailable
+from ros_bridge.goal_status import ActionGoal, ActionOutcome
+from ros_bridge.progress import GoalProgress
 from ros_bridge.runtime import RosRuntime
 
 logger = logging.getLogger(__name__)
@@ -36,71 +41,24 @@ _STATUS_NAMES = {
 }
 
 
-@dataclass(frozen=True)
-class GoalProgress:
-    """The latest feedback of a goal; progress never goes down."""
+class _GoalOverRos:
+    """The creator of one `ActionGoal`: finishes it from rclpy's answers, cancels it on request.
 
-    progress: float = 0.0
-    phase: str = "pending"
-    remaining_time_s: float = 0.0
-    feedback_count: int = 0
-
-
-@dataclass(frozen=True)
-class ActionOutcome:
-    """How a goal ended. `error_code` is empty exactly when `success` is true."""
-
-    success: bool
-    error_code: str
-    message: str
-    status: str
-    result: Any = None
-
-
-class ActionGoal:
-    """A sent goal: a status object with progress, a result future and cancel."""
+    Threads: the `_on_*` methods run on the ROS thread (rclpy callbacks) and never raise;
+    `cancel` runs on the caller's thread and hands the rclpy call over."""
 
     def __init__(self, runtime: RosRuntime, action_name: str) -> None:
         self._runtime = runtime
-        self.action_name = action_name
-        self.accepted: concurrent.futures.Future[bool] = concurrent.futures.Future()
-        self.outcome: concurrent.futures.Future[ActionOutcome] = concurrent.futures.Future()
-        self._lock = threading.Lock()
-        self._progress = GoalProgress()
-        self._listeners: list[Callable[[GoalProgress], None]] = []
+        self.status = ActionGoal(action_name, cancel_request=self.cancel)
+        self._lock = threading.Lock()  # the handle and the cancel wish, between caller and ROS thread
         self._ros_handle: ClientGoalHandle | None = None
         self._cancel_requested = False
-        self.sent_at = time.monotonic()
 
     @property
-    def progress(self) -> GoalProgress:
-        with self._lock:
-            return self._progress
+    def _name(self) -> str:
+        return self.status.action_name
 
-    def add_listener(self, listener: Callable[[GoalProgress], None]) -> None:
-        """Call `listener(progress)` on every feedback (on the ROS thread)."""
-        with self._lock:
-            self._listeners.append(listener)
-
-    def wait_accepted(self, timeout_s: float = 10.0) -> None:
-        """Return once the server accepted the goal; raise GoalRejected or BridgeTimeout."""
-        try:
-            accepted = self.accepted.result(timeout=timeout_s)
-        except concurrent.futures.TimeoutError as error:
-            raise BridgeTimeout(
-                f"{self.action_name}: no answer to the goal request within {timeout_s:.1f} s"
-            ) from error
-        if not accepted:
-            raise GoalRejected(f"{self.action_name}: the action server rejected the goal")
-
-    def result(self, timeout_s: float | None = None) -> ActionOutcome:
-        """Wait for the outcome. A rejected goal is an unsuccessful outcome, not an exception."""
-        try:
-            return self.outcome.result(timeout=timeout_s)
-        except concurrent.futures.TimeoutError as error:
-            raise BridgeTimeout(f"{self.action_name}: no result within {timeout_s:.1f} s") from error
-
-    def cancel(self, timeout_s: float = 5.0) -> bool:
+    def cancel(self, timeout_s: float) -> bool:
         """Ask the server to cancel; True if it agreed (or the goal had not been accepted yet)."""
         with self._lock:
             self._cancel_requested = True
@@ -118,7 +76,7 @@ class ActionGoal:
             response = answer.result(timeout=timeout_s)
         except concurrent.futures.TimeoutError as error:
             raise BridgeTimeout(
-                f"{self.action_name}: no answer to the cancel request within {timeout_s:.1f} s"
+                f"{self._name}: no answer to the cancel request within {timeout_s:.1f} s"
             ) from error
         return bool(response.goals_canceling)
 
@@ -126,38 +84,25 @@ class ActionGoal:
 
     def _on_feedback(self, feedback_message: Any) -> None:
         feedback = feedback_message.feedback
-        with self._lock:
-            self._progress = GoalProgress(
-                progress=max(self._progress.progress, min(1.0, float(getattr(feedback, "progress", 0.0)))),
-                phase=str(getattr(feedback, "phase", "")),
-                remaining_time_s=max(0.0, float(getattr(feedback, "remaining_time_s", 0.0))),
-                feedback_count=self._progress.feedback_count + 1,
-            )
-            progress, listeners = self._progress, list(self._listeners)
-        for listener in listeners:
-            try:
-                listener(progress)
-            except Exception:  # noqa: BLE001 - a broken listener must not stop the executor
-                logger.exception("%s: feedback listener failed", self.action_name)
+        self.status.update_progress(
+            float(getattr(feedback, "progress", 0.0)),
+            str(getattr(feedback, "phase", "")),
+            float(getattr(feedback, "remaining_time_s", 0.0)),
+        )
 
     def _on_goal_response(self, response_future: Any) -> None:
         error = response_future.exception()
         if error is not None:
-            self._finish_with_error(BridgeError(f"{self.action_name}: goal request failed: {error}"))
+            self.status.set_exception(BridgeError(f"{self._name}: goal request failed: {error}"))
             return
         ros_handle: ClientGoalHandle = response_future.result()
         if not ros_handle.accepted:
-            self.accepted.set_result(False)
-            self.outcome.set_result(
-                ActionOutcome(
-                    False, "REJECTED", f"{self.action_name}: goal rejected by the server", "REJECTED"
-                )
-            )
+            self.status.set_rejected(f"{self._name}: goal rejected by the server")
             return
         with self._lock:
             self._ros_handle = ros_handle
             cancel_now = self._cancel_requested
-        self.accepted.set_result(True)
+        self.status.set_accepted()
         ros_handle.get_result_async().add_done_callback(self._on_result)
         if cancel_now:
             ros_handle.cancel_goal_async()
@@ -165,7 +110,7 @@ class ActionGoal:
     def _on_result(self, result_future: Any) -> None:
         error = result_future.exception()
         if error is not None:
-            self._finish_with_error(BridgeError(f"{self.action_name}: result request failed: {error}"))
+            self.status.set_exception(BridgeError(f"{self._name}: result request failed: {error}"))
             return
         wrapped = result_future.result()
         result = wrapped.result
@@ -173,17 +118,7 @@ class ActionGoal:
         success = wrapped.status == GoalStatus.STATUS_SUCCEEDED and bool(getattr(result, "success", True))
         error_code = "" if success else (str(getattr(result, "error_code", "")) or status)
         message = str(getattr(result, "message", ""))
-        if success:
-            with self._lock:
-                self._progress = GoalProgress(1.0, "done", 0.0, self._progress.feedback_count)
-        self.outcome.set_result(ActionOutcome(success, error_code, message, status, result))
-
-    def _finish_with_error(self, error: BridgeError) -> None:
-        logger.warning("%s", error)
-        if not self.accepted.done():
-            self.accepted.set_exception(error)
-        if not self.outcome.done():
-            self.outcome.set_exception(error)
+        self.status.set_finished(ActionOutcome(success, error_code, message, status, result))
 
 
 class ActionCaller:
@@ -214,17 +149,18 @@ class ActionCaller:
             time.sleep(0.05)
 
     def send(self, goal: Any, on_feedback: Callable[[GoalProgress], None] | None = None) -> ActionGoal:
-        """Send `goal`; returns at once with a handle (acceptance and result come later)."""
-        handle = ActionGoal(self._runtime, self.action_name)
+        """Send `goal`; returns at once with its status (acceptance and result come later).
+        Raises BridgeError if the ROS thread could not take the request."""
+        over_ros = _GoalOverRos(self._runtime, self.action_name)
         if on_feedback is not None:
-            handle.add_listener(on_feedback)
+            over_ros.status.add_progress_listener(on_feedback)
 
         def send_on_ros_thread() -> None:
-            response_future = self._client.send_goal_async(goal, feedback_callback=handle._on_feedback)
-            response_future.add_done_callback(handle._on_goal_response)
+            response_future = self._client.send_goal_async(goal, feedback_callback=over_ros._on_feedback)
+            response_future.add_done_callback(over_ros._on_goal_response)
 
         self._runtime.call(send_on_ros_thread)
-        return handle
+        return over_ros.status
 
     def run(
         self,
@@ -234,12 +170,12 @@ class ActionCaller:
         accept_timeout_s: float = 10.0,
     ) -> ActionOutcome:
         """Send, wait for acceptance and for the outcome; cancel the goal if it times out."""
-        handle = self.send(goal, on_feedback)
-        handle.wait_accepted(accept_timeout_s)
+        status = self.send(goal, on_feedback)
+        status.wait_accepted(accept_timeout_s)
         try:
-            return handle.result(timeout_s)
+            return status.result(timeout_s)
         except BridgeTimeout:
-            handle.cancel()
+            status.cancel()
             raise
 
     def destroy(self) -> None:
@@ -253,3 +189,6 @@ def _copy_ros_future(ros_future: Any, target: concurrent.futures.Future) -> None
         target.set_exception(error)
     else:
         target.set_result(ros_future.result())
+
+
+__all__ = ["ActionCaller", "ActionGoal", "ActionOutcome", "GoalProgress"]

@@ -17,3 +17,8 @@ class ServerUnavailable(BridgeError):
 
 class GoalRejected(BridgeError):
     """The action server rejected the goal (for instance, it is busy)."""
+
+
+class GoalAbandoned(BridgeError):
+    """This side stopped waiting for a goal because the robot side is gone and will not answer
+    (`ActionGoal.abort`, used by the deployment's supervisor). Nothing was sent to the robot."""

@@ -12,9 +12,7 @@ with a timeout. Listeners registered here run on the ROS thread.
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
-from typing import Any
+from collections.abc import Callable
 
 from labware_interfaces.action import Dock, GetLabware, NavigateToPoi, PutLabware, Undock
 from labware_interfaces.msg import RobotState, StationStates
@@ -26,6 +24,7 @@ from ros_bridge.services import ServiceCaller
 from ros_bridge.topics import TopicMirror
 from ros_bridge.workcell import (
     HotelSlotContent,
+    LabwareHandover,
     NestOccupancy,
     PlacementCheck,
     RobotStatus,
@@ -61,30 +60,11 @@ def nest_occupancies_from_message(message: StationStates) -> tuple[NestOccupancy
     )
 
 
-@dataclass(frozen=True)
-class LabwareHandover:
-    """What GetLabware and PutLabware goals carry: the station nest, the hotel slot, the plate."""
-
-    station: str
-    sub_position: int
-    hotel_slot: int
-    labware_type: str
-    labware_id: str
-    intermediate_actions: Sequence[str] = ()
-
-    def goal(self, goal_type: Callable[..., Any]) -> Any:
-        return goal_type(
-            handover_position=self.station,
-            sub_position=self.sub_position,
-            internal_position=self.hotel_slot,
-            labware_type=self.labware_type,
-            labware_id=self.labware_id,
-            intermediate_actions=list(self.intermediate_actions),
-        )
-
-
 class RobotLink:
-    """Clients of every robot-side action, service and topic, sharing one `RosRuntime`."""
+    """Clients of every robot-side action, service and topic, sharing one `RosRuntime`.
+
+    It is the ROS back end of `sila_labware.device.robot_backend.RobotBackend` (checked by the
+    tests); that protocol's docstrings state the units, errors and threads of the methods it names."""
 
     def __init__(self, runtime: RosRuntime) -> None:
         self.runtime = runtime

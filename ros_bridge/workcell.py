@@ -1,12 +1,15 @@
 """Plain-Python views of what the robot side reports, so layers above never touch ROS messages.
 
-These are immutable snapshots built from labware_interfaces messages (see `robot_link.py`);
-they hold SI units (m, rad) like the messages they come from.
+These are immutable snapshots built from labware_interfaces messages (see `robot_link.py`),
+plus the one request the layers above build (`LabwareHandover`, what a GetLabware/PutLabware goal
+carries); they hold SI units (m, rad) like the messages they come from.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 
 @dataclass(frozen=True)
@@ -83,3 +86,26 @@ class PlacementCheck:
     yaw_error_rad: float
     location: str
     outside: str = ""  # in the expected nest but outside its tolerance: the limits it missed
+
+
+@dataclass(frozen=True)
+class LabwareHandover:
+    """What GetLabware and PutLabware goals carry: the station nest (1-based sub-position), the
+    robot's hotel slot (1-based), the plate's type and id, the intermediate actions to run."""
+
+    station: str
+    sub_position: int
+    hotel_slot: int
+    labware_type: str
+    labware_id: str
+    intermediate_actions: Sequence[str] = ()
+
+    def goal(self, goal_type: Callable[..., Any]) -> Any:
+        return goal_type(
+            handover_position=self.station,
+            sub_position=self.sub_position,
+            internal_position=self.hotel_slot,
+            labware_type=self.labware_type,
+            labware_id=self.labware_id,
+            intermediate_actions=list(self.intermediate_actions),
+        )

@@ -1,20 +1,23 @@
 """An Ophyd status that follows one ROS 2 action goal: progress to watchers, result to callbacks.
 
 Bluesky waits on Ophyd status objects; our robot answers with ROS 2 action goals
-(`ros_bridge.actions.ActionGoal`). `ActionStatus` joins the two: action feedback becomes
+(`ros_bridge.goal_status.ActionGoal`). `ActionStatus` joins the two: action feedback becomes
 MoveStatus-style watcher calls (so bluesky's ProgressBar draws a bar in percent), the action's
 outcome finishes the status (or fails it with `ActionFailed`, carrying the action's error code
 and message), and a failed status - timeout, or the device being stopped - cancels the goal.
 
-Threads: feedback and outcome arrive on the ROS thread of the `RosRuntime`; watchers are called
-there and must stay short. A status with a timeout runs its callbacks on Ophyd's own callback
-thread. Cancelling never blocks the calling thread: it is sent from a short-lived helper thread,
-because the ROS thread must not wait on its own answers.
+It consumes the goal's status contract (ros_bridge.goal_status): a progress listener for the
+watchers, a completion callback for the end; it never touches the goal's internals.
+
+Threads: feedback and outcome arrive on the ROS thread of the `RosRuntime` (the goal's progress
+listeners and callbacks run there); watchers are called there and must stay short. A status with
+a timeout runs its callbacks on Ophyd's own callback thread. Cancelling never blocks the calling
+thread: it is sent from a short-lived helper thread, because the ROS thread must not wait on its
+own answers.
 """
 
 from __future__ import annotations
 
-import concurrent.futures
 import logging
 import threading
 import time
@@ -24,8 +27,9 @@ from typing import Any
 from ophyd.status import DeviceStatus
 from ophyd.utils import InvalidState
 
-from ros_bridge.actions import ActionGoal, ActionOutcome, GoalProgress
 from ros_bridge.errors import BridgeError
+from ros_bridge.goal_status import ActionGoal, ActionOutcome
+from ros_bridge.progress import GoalProgress
 
 logger = logging.getLogger(__name__)
 
@@ -66,8 +70,8 @@ class ActionStatus(DeviceStatus):
         self._started_at = time.monotonic()
         # The status cancels its own goal on failure (see _handle_failure); the device need not.
         super().__init__(device, timeout=timeout, call_stop_on_failure=False)
-        goal.add_listener(self._on_progress)
-        goal.outcome.add_done_callback(self._on_outcome)
+        goal.add_progress_listener(self._on_progress)
+        goal.add_callback(self._on_goal_finished)
 
     @property
     def progress(self) -> GoalProgress:
@@ -80,7 +84,7 @@ class ActionStatus(DeviceStatus):
 
     def cancel_goal(self) -> None:
         """Ask the robot to cancel the goal unless it has already ended; returns at once."""
-        if self.goal.outcome.done():
+        if self.goal.done:
             return
         with self._cancel_lock:
             if self._cancel_sent:
@@ -115,10 +119,11 @@ class ActionStatus(DeviceStatus):
             except Exception:  # noqa: BLE001 - a broken progress bar must not fail the goal
                 logger.exception("%s: progress watcher failed", self.label)
 
-    def _on_outcome(self, outcome_future: concurrent.futures.Future[ActionOutcome]) -> None:
-        error = outcome_future.exception()
+    def _on_goal_finished(self, goal: ActionGoal) -> None:
+        error: Exception | None = goal.exception()  # finished: returns at once
         if error is None:
-            self.outcome = outcome_future.result()
+            self.outcome = goal.outcome
+            assert self.outcome is not None  # answered goals carry an outcome
             if not self.outcome.success:
                 error = ActionFailed(
                     self.label, self.outcome.error_code, self.outcome.message, self.outcome.status
@@ -141,7 +146,7 @@ class ActionStatus(DeviceStatus):
         except BridgeError as error:
             logger.warning("%s: cancel request failed: %s", self.label, error)
             return
-        if not agreed and not self.goal.outcome.done():
+        if not agreed and not self.goal.done:
             logger.warning("%s: the robot refused to cancel the goal", self.label)
 
     def _watcher_name(self) -> str:

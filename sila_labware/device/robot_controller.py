@@ -1,16 +1,23 @@
 """The robot's behaviour behind its SiLA features: protocol order, checks, ROS goals, inventory.
 
-This is the front-end logic of the active device; the ROS bridge (`RobotLink`) is its back end,
-so a real TIAGo++ serving the same ROS names changes nothing here. It never imports sila2: the
-feature implementations translate its exceptions into SiLA errors:
+This is the front-end logic of the active device; below it is a `RobotBackend` (robot_backend.py):
+the ROS bridge's `RobotLink` in a deployment, so a real TIAGo++ serving the same ROS names changes
+nothing here, or an in-memory fake in the fast tests. It never imports sila2: the feature
+implementations translate its exceptions into SiLA errors:
 
 - `CommandSequenceError` -> InvalidCommandSequence (RobotBusy for motion commands)
 - `ParameterError` -> a validation error naming the parameter
 - `TransferFailed` -> LabwareNotPicked / LabwareNotPlaced, with the robot side's message
 - `MotionFailed` -> the MobileRobotController error for its ROS error code
 
-Threads: methods run on SiLA handler threads and block until the ROS goal ends, waiting on
-futures; progress reports are called on the ROS thread (from action feedback).
+Progress: each command reports through one `CommandProgress` (ros_bridge.progress), which maps
+each of its goals into a share of the command (undock 0..0.2, then drive 0.2..1) and never lets
+the reported fraction go down.
+
+Threads: methods run on SiLA handler threads and block until the goal ends, waiting on the goal's
+status; progress reports are called on the back end's answering thread (the ROS thread) from goal
+feedback, and on the handler thread at the end of a command. `stop_motion` and
+`abort_active_goal` may be called from any other thread while a command waits.
 """
 
 from __future__ import annotations
@@ -18,13 +25,15 @@ from __future__ import annotations
 import logging
 import threading
 from collections.abc import Callable
+from dataclasses import dataclass
 
-from ros_bridge.actions import ActionGoal, ActionOutcome, GoalProgress
 from ros_bridge.errors import BridgeError, BridgeTimeout
-from ros_bridge.robot_link import LabwareHandover, RobotLink
-from ros_bridge.workcell import RobotStatus, WorkcellDescription
+from ros_bridge.goal_status import ActionGoal, ActionOutcome
+from ros_bridge.progress import CommandProgress, ProgressReport
+from ros_bridge.workcell import LabwareHandover, RobotStatus, WorkcellDescription
 from sila_labware.device.errors import CommandSequenceError, ParameterError
 from sila_labware.device.inventory import Inventory, in_hotel
+from sila_labware.device.robot_backend import RobotBackend
 from sila_labware.device.sequences import ManipulatorSequence, PreparedTransfer
 from sila_labware.device.validation import (
     Handover,
@@ -35,9 +44,6 @@ from sila_labware.device.validation import (
 )
 
 logger = logging.getLogger(__name__)
-
-ProgressReport = Callable[[float, float], None]
-"""Called with (progress 0..1, estimated remaining seconds)."""
 
 INTERMEDIATE_ACTIONS: tuple[str, ...] = ()
 """Fully qualified command identifiers this robot can run between pick and place: none yet."""
@@ -61,25 +67,35 @@ class MotionFailed(Exception):
         self.message = message
 
 
-class _ScaledReport:
-    """Maps a step's own 0..1 progress into [start, end] of the whole command, never going down."""
+@dataclass(frozen=True)
+class ControllerWaits:
+    """How long (s) the controller waits on the back end besides a step's own run time."""
 
-    def __init__(self, report: ProgressReport | None, start: float, end: float) -> None:
-        self._report, self._start, self._end = report, start, end
-
-    def __call__(self, progress: GoalProgress) -> None:
-        if self._report is not None:
-            overall = self._start + (self._end - self._start) * progress.progress
-            self._report(overall, progress.remaining_time_s)
+    accept_s: float = 30.0
+    """For the robot side to accept a goal."""
+    cancel_s: float = 10.0
+    """For a goal cancelled after its step timed out to end."""
+    state_report_s: float = 2.0
+    """For the robot state to show a motion's effect (/robot_state lags action results)."""
+    settle_s: float = 3.0
+    """For the robot state and a nest sensor to show a transfer's outcome (/station_states
+    comes at 2 Hz, /robot_state on change)."""
 
 
 class RobotController:
-    """One robot: its protocol state, its inventory, and the ROS goals it sends."""
+    """One robot: its protocol state, its inventory, and the goals it sends to its back end."""
 
-    def __init__(self, link: RobotLink, workcell: WorkcellDescription, step_timeout_s: float = 600.0) -> None:
+    def __init__(
+        self,
+        link: RobotBackend,
+        workcell: WorkcellDescription,
+        step_timeout_s: float = 600.0,
+        waits: ControllerWaits | None = None,
+    ) -> None:
         self.link = link
         self.workcell = workcell
         self.step_timeout_s = step_timeout_s
+        self.waits = waits or ControllerWaits()
         self.sequence = ManipulatorSequence()
         self.inventory = Inventory()
         self._active_goal: ActionGoal | None = None
@@ -122,7 +138,7 @@ class RobotController:
             )
         transfer = PreparedTransfer(handover, internal_position, labware_type, labware_id)
         self.sequence.begin_prepare_for_input(transfer)
-        self._drive_for_transfer(handover, report)
+        self._drive_for_transfer(handover, CommandProgress(report))
 
     def prepare_for_output(
         self, position: str, sub_position: int, internal_position: int, report: ProgressReport | None = None
@@ -141,7 +157,7 @@ class RobotController:
             handover, internal_position, known.labware_type if known else "", occupant
         )
         self.sequence.begin_prepare_for_output(transfer)
-        self._drive_for_transfer(handover, report)
+        self._drive_for_transfer(handover, CommandProgress(report))
 
     def get_labware(
         self,
@@ -187,7 +203,8 @@ class RobotController:
                 intermediate_actions,
             )
             send = self.link.get_labware if getting else self.link.put_labware
-            outcome = self._wait(lambda: send(request, _ScaledReport(report, 0.0, 1.0)), command)
+            progress = CommandProgress(report)
+            outcome = self._wait(lambda: send(request, progress.step(0.0, 1.0)), command)
             labware_id = transfer.labware_id or str(getattr(outcome.result, "labware_id", ""))
             self._settle(labware_id, transfer, outcome, expect_aboard=getting)
             if not outcome.success:
@@ -199,11 +216,13 @@ class RobotController:
     # --- base motions outside the standard ---
 
     def dock(self, report: ProgressReport | None = None) -> None:
-        self._motion("Dock", lambda: self.link.dock(_ScaledReport(report, 0.0, 1.0)))
+        progress = CommandProgress(report)
+        self._motion("Dock", lambda: self.link.dock(progress.step(0.0, 1.0)))
         self._await_state_report(lambda status: status.docked, "docked")
 
     def undock(self, report: ProgressReport | None = None) -> None:
-        self._motion("Undock", lambda: self.link.undock(_ScaledReport(report, 0.0, 1.0)))
+        progress = CommandProgress(report)
+        self._motion("Undock", lambda: self.link.undock(progress.step(0.0, 1.0)))
         self._await_state_report(lambda status: not status.docked, "undocked")
 
     def drive_to_poi(self, poi: str, report: ProgressReport | None = None) -> None:
@@ -214,8 +233,9 @@ class RobotController:
             )
         if self.link.robot_status().docked:
             raise MotionFailed("DOCKED", f"the robot is docked; undock before driving to {poi!r}")
+        progress = CommandProgress(report)
         self._motion(
-            "DriveToPointOfInterest", lambda: self.link.navigate_to_poi(poi, _ScaledReport(report, 0, 1))
+            "DriveToPointOfInterest", lambda: self.link.navigate_to_poi(poi, progress.step(0.0, 1.0))
         )
         self._await_arrival_report(poi)
 
@@ -223,21 +243,18 @@ class RobotController:
         """Cancel whatever goal runs; True if one was running."""
         with self._active_lock:
             goal = self._active_goal
-        if goal is None or goal.outcome.done():
+        if goal is None or goal.done:
             return False
         goal.cancel()
         return True
 
     def abort_active_goal(self, reason: str) -> bool:
-        """End the waiting command now with a failed outcome (the robot side is gone and will not
-        answer); True if one was waiting. The command then settles the inventory and raises its
-        defined error as for any failed goal."""
+        """End the waiting command now (the robot side is gone and will not answer): its goal ends
+        with GoalAbandoned(`reason`); True if a goal was still running. The command then settles
+        the inventory and raises its defined error as for any failed goal. Any thread."""
         with self._active_lock:
             goal = self._active_goal
-        if goal is None or goal.outcome.done():
-            return False
-        goal._finish_with_error(BridgeError(reason))
-        return True
+        return goal is not None and goal.abort(reason)
 
     # --- helpers ---
 
@@ -253,18 +270,16 @@ class RobotController:
     def _await_arrival_report(self, poi: str) -> None:
         self._await_state_report(lambda status: status.current_poi == poi, f"at {poi}")
 
-    def _await_state_report(
-        self, shows: Callable[[RobotStatus], bool], what: str, timeout_s: float = 2.0
-    ) -> None:
+    def _await_state_report(self, shows: Callable[[RobotStatus], bool], what: str) -> None:
         """After a base motion succeeded, wait until /robot_state shows its effect, so that the
         command ends with the state properties (and the next command's checks) already true: the
         state topic lags action results."""
         try:
-            self.link.wait_for_robot_status(shows, timeout_s)
+            self.link.wait_for_robot_status(shows, self.waits.state_report_s)
         except BridgeTimeout:
             logger.warning("the motion succeeded but the robot state does not report %s yet", what)
 
-    def _drive_for_transfer(self, handover: Handover, report: ProgressReport | None) -> None:
+    def _drive_for_transfer(self, handover: Handover, progress: CommandProgress) -> None:
         """Undock if needed, then drive to the station's POI (unless already there)."""
         success = False
         try:
@@ -273,13 +288,13 @@ class RobotController:
             status = self.link.robot_status()
             start = 0.0
             if status.docked:
-                outcome = self._wait(lambda: self.link.undock(_ScaledReport(report, 0.0, 0.2)), "Undock")
+                outcome = self._wait(lambda: self.link.undock(progress.step(0.0, 0.2)), "Undock")
                 if not outcome.success:
                     raise MotionFailed(outcome.error_code, _describe_failure("Undock", outcome))
                 start = 0.2
             if status.current_poi != station.poi or status.docked:
                 outcome = self._wait(
-                    lambda: self.link.navigate_to_poi(station.poi, _ScaledReport(report, start, 1.0)),
+                    lambda: self.link.navigate_to_poi(station.poi, progress.step(start, 1.0)),
                     "NavigateToPoi",
                 )
                 if not outcome.success:
@@ -287,16 +302,15 @@ class RobotController:
                         outcome.error_code, _describe_failure(f"driving to {station.poi}", outcome)
                     )
                 self._await_arrival_report(station.poi)
-            if report is not None:
-                report(1.0, 0.0)
+            progress.finish()
             success = True
         finally:
             self.sequence.finish_prepare(success)
 
     def _wait(self, send: Callable[[], ActionGoal], what: str) -> ActionOutcome:
-        """Send the goal and return its outcome; bridge trouble (no answer, rejection, timeout, even
-        while sending) becomes a failed outcome, so that callers always settle the inventory and
-        raise their own defined error."""
+        """Send the goal and return its outcome; back-end trouble (no answer, rejection, timeout, an
+        abandoned goal, even while sending) becomes a failed outcome whose error code names the
+        bridge error, so that callers always settle the inventory and raise their own defined error."""
         try:
             goal = send()
         except BridgeError as error:
@@ -304,14 +318,14 @@ class RobotController:
         with self._active_lock:
             self._active_goal = goal
         try:
-            goal.wait_accepted(timeout_s=30.0)
+            goal.wait_accepted(self.waits.accept_s)
             try:
                 return goal.result(self.step_timeout_s)
             except BridgeTimeout:
                 logger.warning("%s took longer than %.0f s: cancelling it", what, self.step_timeout_s)
                 goal.cancel()
                 try:
-                    return goal.result(10.0)
+                    return goal.result(self.waits.cancel_s)
                 except BridgeTimeout:
                     return ActionOutcome(
                         False, "TIMEOUT", f"{what}: no result within {self.step_timeout_s:.0f} s", ""
@@ -336,14 +350,16 @@ class RobotController:
             return aboard == expect_aboard if outcome.success else True
 
         try:
-            status = self.link.wait_for_robot_status(shows_outcome, timeout_s=3.0)
+            status = self.link.wait_for_robot_status(shows_outcome, self.waits.settle_s)
         except BridgeTimeout:
             status = self.link.robot_status()
         if outcome.success and not expect_aboard:
             # /station_states comes at 2 Hz, /robot_state on change: without this wait a plate that
             # was placed could be read as in neither place, and recorded as lost (seen in the soak).
             try:
-                self.link.wait_for_nest(transfer.handover.station, transfer.handover.sub_position, True, 3.0)
+                self.link.wait_for_nest(
+                    transfer.handover.station, transfer.handover.sub_position, True, self.waits.settle_s
+                )
             except BridgeTimeout:
                 logger.warning("PutLabware succeeded but the sensor of %s sees no plate", transfer.handover)
         location = self.inventory.settle(
@@ -381,6 +397,7 @@ def _describe_failure(what: str, outcome: ActionOutcome) -> str:
 __all__ = [
     "INTERMEDIATE_ACTIONS",
     "CommandSequenceError",
+    "ControllerWaits",
     "MotionFailed",
     "ParameterError",
     "ProgressReport",

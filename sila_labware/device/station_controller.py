@@ -13,7 +13,10 @@ from that sensor (documented for clients):
 A station has no internal positions of its own; InternalPosition must be 1 (the standard's rule
 for devices without internal positions).
 
-Threads: methods run on SiLA handler threads and only read the bridge's topic mirror.
+Its back end is a `StationBackend` (robot_backend.py): the nest sensors, read through the ROS
+bridge's `RobotLink` in a deployment.
+
+Threads: methods run on SiLA handler threads and only read the back end's sensor mirror.
 """
 
 from __future__ import annotations
@@ -21,9 +24,9 @@ from __future__ import annotations
 import logging
 
 from ros_bridge.errors import BridgeTimeout
-from ros_bridge.robot_link import RobotLink
 from ros_bridge.workcell import NestOccupancy, StationDescription
 from sila_labware.device.errors import CommandSequenceError
+from sila_labware.device.robot_backend import StationBackend
 from sila_labware.device.sequences import NestExpectation, NestPhase, SiteSequence
 from sila_labware.device.validation import check_handover, check_internal_position, check_text
 
@@ -35,7 +38,9 @@ STATION_INTERNAL_POSITIONS = 1
 class StationController:
     """One station: its name, its nests, and their protocol state."""
 
-    def __init__(self, link: RobotLink, station: StationDescription, settle_timeout_s: float = 5.0) -> None:
+    def __init__(
+        self, link: StationBackend, station: StationDescription, settle_timeout_s: float = 5.0
+    ) -> None:
         self.link = link
         self.station = station
         self.settle_timeout_s = settle_timeout_s

@@ -1,13 +1,13 @@
 """Small translations between our robot logic and the sila2 library, shared by both servers.
 
-Threads: `progress_reporter`'s callable is called on the ROS thread (action feedback); sila2's
-command instance notifies subscribers itself, so the call is short.
+Threads: `progress_reporter`'s callable is called on the ROS thread (goal feedback) and on the
+command's handler thread (its last report); sila2's command instance notifies subscribers
+itself, so the call is short.
 """
 
 from __future__ import annotations
 
 import logging
-import threading
 from datetime import timedelta
 
 from sila2.framework import ValidationError
@@ -36,18 +36,18 @@ def validation_error(feature: Feature, command: str, error: ParameterError) -> V
 
 
 def progress_reporter(instance: ObservableCommandInstance) -> ProgressReport:
-    """Feed (progress, remaining seconds) into a command instance; progress never goes down."""
-    lock = threading.Lock()
-    highest = [0.0]
+    """Write a command's (progress, remaining seconds) into its SiLA command instance.
+
+    The numbers come from the RobotController's `CommandProgress` (ros_bridge.progress), which
+    owns the rule that a command's progress stays in 0..1 and never goes down, across all the
+    goals of the command; this only writes them, in the order they come."""
 
     def report(progress: float, remaining_s: float) -> None:
-        with lock:
-            highest[0] = max(highest[0], min(1.0, max(0.0, progress)))
-            try:
-                instance.progress = highest[0]
-                instance.estimated_remaining_time = timedelta(seconds=max(0.0, remaining_s))
-            except Exception:  # noqa: BLE001 - a closed instance must not break the ROS thread
-                logger.debug("could not update a command instance", exc_info=True)
+        try:
+            instance.progress = progress
+            instance.estimated_remaining_time = timedelta(seconds=remaining_s)
+        except Exception:  # noqa: BLE001 - a closed instance must not break the ROS thread
+            logger.debug("could not update a command instance", exc_info=True)
 
     return report
 

@@ -35,7 +35,10 @@ def test_goal_crosses_processes_with_feedback_and_result(echo_server, runtime: R
         listener_threads.add(threading.current_thread().name)
 
     goal = navigate.send(NavigateToPoi.Goal(poi="reader_poi"), on_feedback=on_feedback)
+    callback_threads: list[str] = []
+    goal.add_callback(lambda _goal: callback_threads.append(threading.current_thread().name))
     goal.wait_accepted(timeout_s=5.0)
+    assert goal.accepted is True
     outcome = goal.result(timeout_s=10.0)
 
     assert outcome.success and outcome.error_code == "" and outcome.status == "SUCCEEDED"
@@ -47,6 +50,8 @@ def test_goal_crosses_processes_with_feedback_and_result(echo_server, runtime: R
     assert seen[0].remaining_time_s > seen[-1].remaining_time_s
     assert goal.progress.progress == 1.0 and goal.progress.phase == "done"
     assert listener_threads == {"ros-bridge_test_client"}, "feedback must arrive on the ROS thread"
+    assert goal.done and goal.success and goal.exception() is None
+    assert callback_threads == ["ros-bridge_test_client"], "the ROS thread finishes the goal, once"
 
 
 def test_abort_carries_error_code_and_message(echo_server, runtime: RosRuntime) -> None:
@@ -69,6 +74,7 @@ def test_cancel_passes_through(echo_server, runtime: RosRuntime) -> None:
     outcome = goal.result(timeout_s=5.0)
     assert outcome.status == "CANCELED" and outcome.error_code == "CANCELED"
     assert outcome.message.startswith("cancelled after")
+    assert not goal.success and goal.cancel(timeout_s=5.0) is False, "an ended goal has nothing to cancel"
 
 
 def test_topic_mirror_sees_publisher_in_other_process(echo_server, runtime: RosRuntime) -> None:

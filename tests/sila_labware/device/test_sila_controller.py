@@ -1,5 +1,6 @@
 """RobotController against a real rclpy peer in another process: step timeouts cancel the ROS goal,
-refusals come before any goal is sent."""
+refusals come before any goal is sent. The same paths, and more, run against the in-memory fake
+in test_robot_controller_fast.py; these keep the real ROS back end honest."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ import pytest
 
 from ros_bridge.robot_link import RobotLink
 from ros_bridge.workcell import StationDescription, WorkcellDescription
+from sila_labware.device.robot_backend import RobotBackend, StationBackend
 from sila_labware.device.robot_controller import MotionFailed, RobotController
 
 WORKCELL = WorkcellDescription(
@@ -41,3 +43,7 @@ def test_refusals_send_no_goal(link: RobotLink) -> None:
     assert controller.stop_motion() is False  # nothing runs
     time.sleep(0.3)
     assert link.robot_status().detail == before  # the peer finished no goal meanwhile
+
+
+def test_the_ros_link_is_the_controllers_back_end(link: RobotLink) -> None:
+    assert isinstance(link, RobotBackend) and isinstance(link, StationBackend)

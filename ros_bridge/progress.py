@@ -1,0 +1,91 @@
+"""Progress of a goal and of a command made of goals: a fraction done that never goes down.
+
+"Progress never goes down" is written once, in `MonotonicProgress`: a goal's feedback
+(`ActionGoal`) and a command's report (`CommandProgress`, which maps each of its goals into a
+share of 0..1) both pass their numbers through one. A robot side that re-plans may estimate less
+than before; callers (a SiLA client's progress bar, Bluesky's ProgressBar) must never see a bar
+shrink, so the fraction shown stays at its highest.
+
+Threads: both classes are thread-safe (one lock each). Goal feedback arrives on the ROS thread;
+a command's own reports come from the SiLA handler thread that runs it.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from collections.abc import Callable
+from dataclasses import dataclass
+
+ProgressReport = Callable[[float, float], None]
+"""Called with (fraction done 0..1, estimated remaining time in s)."""
+
+
+@dataclass(frozen=True)
+class GoalProgress:
+    """The latest feedback of a goal: `progress` is the fraction done (0..1, never goes down),
+    `phase` the robot side's word for what it does, `remaining_time_s` its estimate (>= 0)."""
+
+    progress: float = 0.0
+    phase: str = "pending"
+    remaining_time_s: float = 0.0
+    feedback_count: int = 0
+
+
+class MonotonicProgress:
+    """A fraction done in 0..1 that only rises: the one place the rule is written."""
+
+    def __init__(self, fraction: float = 0.0) -> None:
+        self._lock = threading.Lock()
+        self._fraction = 0.0
+        self.advance(fraction)
+
+    @property
+    def fraction(self) -> float:
+        with self._lock:
+            return self._fraction
+
+    def advance(self, estimate: float) -> float:
+        """Take a new estimate; return the fraction to show: clamped to 0..1 and never below the
+        highest shown so far. A NaN or infinite estimate changes nothing."""
+        with self._lock:
+            if math.isfinite(estimate):
+                self._fraction = max(self._fraction, min(1.0, max(0.0, estimate)))
+            return self._fraction
+
+
+class CommandProgress:
+    """The progress of one command that runs goals one after another, each in its share
+    [start, end] of the command's 0..1 (for instance undock in 0..0.2, then drive in 0.2..1).
+
+    Every number goes through one `MonotonicProgress`, so the command's report never goes down,
+    across goals too (a later goal whose share starts lower cannot pull it back). `report` may be
+    None: the command then runs without anyone watching."""
+
+    def __init__(self, report: ProgressReport | None) -> None:
+        self._report = report
+        self._fraction = MonotonicProgress()
+        self._lock = threading.Lock()  # keeps reports in order when two threads report at once
+
+    @property
+    def fraction(self) -> float:
+        return self._fraction.fraction
+
+    def step(self, start: float, end: float) -> Callable[[GoalProgress], None]:
+        """A feedback listener for the goal that covers [start, end] of this command."""
+
+        def on_goal_progress(progress: GoalProgress) -> None:
+            self.report(start + (end - start) * progress.progress, progress.remaining_time_s)
+
+        return on_goal_progress
+
+    def report(self, fraction: float, remaining_time_s: float) -> None:
+        """Report the command's own fraction done and the remaining time in s (>= 0)."""
+        with self._lock:
+            shown = self._fraction.advance(fraction)
+            if self._report is not None:
+                self._report(shown, max(0.0, remaining_time_s))
+
+    def finish(self) -> None:
+        """The command's work is done: report 1 with nothing remaining."""
+        self.report(1.0, 0.0)

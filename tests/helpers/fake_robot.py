@@ -1,0 +1,281 @@
+"""An in-memory robot back end (a `RobotBackend`) for millisecond tests of the device logic.
+
+The test sets what the robot reports (its state, the nest sensors) and scripts how each goal
+ends: `succeed()` (the robot state then shows the goal's natural effect: at the POI, docked, the
+plate moved between nest and hotel), `fail(code)`, `never_ends()` (no answer, cancel refused),
+`ends_when_cancelled()`, `rejected()` or `unsendable()`. Unscripted goals succeed. Each goal is a
+real `ActionGoal` finished by the fake, as the ROS bridge's ROS thread finishes it in a
+deployment; every goal sent is recorded in `sent`.
+
+Threads: a goal that ends does so inside the call that sends it (feedback first, then the end),
+on the calling thread; one scripted to wait is finished by a cancel request, on the canceller's
+thread. State waits use a condition, so a test may change the state from another thread.
+"""
+
+from __future__ import annotations
+
+import enum
+import threading
+import time
+from collections import defaultdict, deque
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+from types import SimpleNamespace
+from typing import Any
+
+from ros_bridge.errors import BridgeError, BridgeTimeout
+from ros_bridge.goal_status import ActionGoal, ActionOutcome
+from ros_bridge.progress import GoalProgress
+from ros_bridge.workcell import HotelSlotContent, LabwareHandover, NestOccupancy, RobotStatus
+
+FeedbackListener = Callable[[GoalProgress], None]
+
+
+class GoalEnd(enum.Enum):
+    SUCCEED = "succeed"
+    FAIL = "fail"
+    NEVER = "never ends"
+    WHEN_CANCELLED = "ends when cancelled"
+    REJECTED = "rejected"
+    UNSENDABLE = "cannot be sent"
+
+
+@dataclass(frozen=True)
+class ScriptedGoal:
+    """How one goal goes: feedback fractions, a hook while it runs, how it ends, what it leaves."""
+
+    end: GoalEnd = GoalEnd.SUCCEED
+    error_code: str = ""
+    message: str = ""
+    feedback: tuple[float, ...] = ()
+    while_running: Callable[[], None] | None = None
+    """Called on the sending thread after the feedback and before the end (a second command)."""
+    robot_after: RobotStatus | None = None
+    """The robot state once the goal ends, instead of its natural effect (success) or no change."""
+    nests_after: tuple[NestOccupancy, ...] | None = None
+    result: Any = None
+
+
+def succeed(**details: Any) -> ScriptedGoal:
+    return ScriptedGoal(GoalEnd.SUCCEED, **details)
+
+
+def fail(error_code: str, message: str = "", **details: Any) -> ScriptedGoal:
+    return ScriptedGoal(GoalEnd.FAIL, error_code, message or f"scripted failure {error_code}", **details)
+
+
+def never_ends(**details: Any) -> ScriptedGoal:
+    return ScriptedGoal(GoalEnd.NEVER, **details)
+
+
+def ends_when_cancelled(**details: Any) -> ScriptedGoal:
+    return ScriptedGoal(GoalEnd.WHEN_CANCELLED, **details)
+
+
+def rejected() -> ScriptedGoal:
+    return ScriptedGoal(GoalEnd.REJECTED)
+
+
+def unsendable() -> ScriptedGoal:
+    return ScriptedGoal(GoalEnd.UNSENDABLE)
+
+
+def robot_state(
+    state: str = "idle", poi: str = "", hotel: dict[int, str] | None = None, held: str = ""
+) -> RobotStatus:
+    """A robot state with hotel slot -> plate id (empty string: free); two free slots by default."""
+    slots = tuple(HotelSlotContent(index, plate, "") for index, plate in (hotel or {1: "", 2: ""}).items())
+    return RobotStatus(state, "", poi, 0.0, 0.0, 0.0, slots, held)
+
+
+def nest(station: str, sub_position: int, plate: str = "", occupied: bool | None = None) -> NestOccupancy:
+    """A nest reading; occupied when it holds a plate unless `occupied` says otherwise."""
+    return NestOccupancy(station, sub_position, bool(plate) if occupied is None else occupied, plate)
+
+
+@dataclass
+class SentGoal:
+    """One goal the device logic sent: which action, with what, its status, cancel requests."""
+
+    action: str
+    argument: Any
+    goal: ActionGoal
+    cancel_requests: list[float] = field(default_factory=list)
+
+
+class FakeRobot:
+    """Satisfies `sila_labware.device.robot_backend.RobotBackend` in memory."""
+
+    def __init__(self, robot: RobotStatus | None = None, nests: tuple[NestOccupancy, ...] = ()) -> None:
+        self._changed = threading.Condition()
+        self._robot = robot or robot_state()
+        self._nests = tuple(nests)
+        self._listeners: list[Callable[[RobotStatus], None]] = []
+        self._scripts: dict[str, deque[ScriptedGoal]] = defaultdict(deque)
+        self.sent: list[SentGoal] = []
+
+    # --- the test's controls ---
+
+    def script(self, action: str, *goals: ScriptedGoal) -> None:
+        """Queue how the next goals of `action` ("navigate_to_poi", "dock", ...) go."""
+        self._scripts[action].extend(goals)
+
+    def set_robot_status(self, robot: RobotStatus) -> None:
+        with self._changed:
+            changed, self._robot = robot != self._robot, robot
+            listeners = list(self._listeners) if changed else []
+            self._changed.notify_all()
+        for listener in listeners:
+            listener(robot)
+
+    def set_nests(self, nests: tuple[NestOccupancy, ...]) -> None:
+        with self._changed:
+            self._nests = tuple(nests)
+            self._changed.notify_all()
+
+    def actions_sent(self) -> list[str]:
+        return [sent.action for sent in self.sent]
+
+    # --- RobotBackend: state ---
+
+    def robot_status(self, timeout_s: float = 5.0) -> RobotStatus:
+        with self._changed:
+            return self._robot
+
+    def wait_for_robot_status(
+        self, predicate: Callable[[RobotStatus], bool], timeout_s: float = 5.0
+    ) -> RobotStatus:
+        with self._changed:
+            if not self._changed.wait_for(lambda: predicate(self._robot), timeout_s):
+                raise BridgeTimeout(f"no matching message on /robot_state within {timeout_s:.1f} s")
+            return self._robot
+
+    def on_robot_status(self, listener: Callable[[RobotStatus], None]) -> None:
+        with self._changed:
+            self._listeners.append(listener)
+
+    def nest_occupancies(self, timeout_s: float = 5.0) -> tuple[NestOccupancy, ...]:
+        with self._changed:
+            return self._nests
+
+    def wait_for_nest(self, station: str, sub_position: int, occupied: bool, timeout_s: float = 5.0) -> None:
+        def shows() -> bool:
+            return any(
+                (reading.station, reading.sub_position, reading.occupied) == (station, sub_position, occupied)
+                for reading in self._nests
+            )
+
+        with self._changed:
+            if not self._changed.wait_for(shows, timeout_s):
+                raise BridgeTimeout(f"no matching message on /station_states within {timeout_s:.1f} s")
+
+    # --- RobotBackend: goals ---
+
+    def navigate_to_poi(self, poi: str, on_feedback: FeedbackListener | None = None) -> ActionGoal:
+        return self._send("navigate_to_poi", poi, on_feedback)
+
+    def dock(self, on_feedback: FeedbackListener | None = None) -> ActionGoal:
+        return self._send("dock", None, on_feedback)
+
+    def undock(self, on_feedback: FeedbackListener | None = None) -> ActionGoal:
+        return self._send("undock", None, on_feedback)
+
+    def get_labware(
+        self, handover: LabwareHandover, on_feedback: FeedbackListener | None = None
+    ) -> ActionGoal:
+        return self._send("get_labware", handover, on_feedback)
+
+    def put_labware(
+        self, handover: LabwareHandover, on_feedback: FeedbackListener | None = None
+    ) -> ActionGoal:
+        return self._send("put_labware", handover, on_feedback)
+
+    # --- helpers ---
+
+    def _send(self, action: str, argument: Any, on_feedback: FeedbackListener | None) -> ActionGoal:
+        script = self._scripts[action].popleft() if self._scripts[action] else succeed()
+        if script.end is GoalEnd.UNSENDABLE:
+            raise BridgeError(f"/{action}: the ROS runtime is not running")
+
+        def cancel_request(timeout_s: float) -> bool:
+            return self._cancel(sent, script, timeout_s)
+
+        sent = SentGoal(action, argument, ActionGoal(f"/{action}", cancel_request))
+        goal = sent.goal
+        if on_feedback is not None:
+            goal.add_progress_listener(on_feedback)
+        self.sent.append(sent)
+        if script.end is GoalEnd.REJECTED:
+            goal.set_rejected()
+            return goal
+        goal.set_accepted()
+        for fraction in script.feedback:
+            goal.update_progress(fraction, action, 1.0 - fraction)
+        if script.while_running is not None:
+            script.while_running()
+        if script.end is GoalEnd.SUCCEED:
+            self._apply(script.robot_after or self._natural_effect(action, argument), script.nests_after)
+            goal.set_finished(ActionOutcome(True, "", f"{action} done", "SUCCEEDED", script.result))
+        elif script.end is GoalEnd.FAIL:
+            self._apply(script.robot_after, script.nests_after)
+            goal.set_finished(
+                ActionOutcome(False, script.error_code, script.message, "ABORTED", script.result)
+            )
+        return goal
+
+    def _cancel(self, sent: SentGoal, script: ScriptedGoal, timeout_s: float) -> bool:
+        sent.cancel_requests.append(timeout_s)
+        if script.end is not GoalEnd.WHEN_CANCELLED:
+            return False
+        self._apply(script.robot_after, script.nests_after)
+        waited_s = time.monotonic() - sent.goal.sent_at
+        sent.goal.set_finished(
+            ActionOutcome(False, "CANCELED", f"cancelled after {waited_s:.3f} s", "CANCELED", script.result)
+        )
+        return True
+
+    def _apply(self, robot: RobotStatus | None, nests: tuple[NestOccupancy, ...] | None) -> None:
+        if nests is not None:
+            self.set_nests(nests)
+        if robot is not None:
+            self.set_robot_status(robot)
+
+    def _natural_effect(self, action: str, argument: Any) -> RobotStatus:
+        """What a successful goal leaves: the base at the POI, (un)docked, the plate moved."""
+        robot = self.robot_status()
+        if action == "navigate_to_poi":
+            return replace(robot, state="idle", current_poi=argument)
+        if action == "dock":
+            return replace(robot, state="docked")
+        if action == "undock":
+            return replace(robot, state="idle")
+        handover: LabwareHandover = argument
+        getting = action == "get_labware"
+        plate = handover.labware_id or (self._plate_in_nest(handover) if getting else "")
+        slot_plate = plate if getting else ""
+        hotel = tuple(
+            replace(slot, labware_id=slot_plate, labware_type=handover.labware_type if getting else "")
+            if slot.index == handover.hotel_slot
+            else slot
+            for slot in robot.hotel
+        )
+        self.set_nests(
+            tuple(
+                nest(reading.station, reading.sub_position, "" if getting else plate)
+                if (reading.station, reading.sub_position) == (handover.station, handover.sub_position)
+                else reading
+                for reading in self.nest_occupancies()
+            )
+        )
+        return replace(robot, hotel=hotel)
+
+    def _plate_in_nest(self, handover: LabwareHandover) -> str:
+        for reading in self.nest_occupancies():
+            if (reading.station, reading.sub_position) == (handover.station, handover.sub_position):
+                return reading.labware_id
+        return ""
+
+
+def result_with_labware_id(labware_id: str) -> SimpleNamespace:
+    """A GetLabware result as the robot side returns it when it read the plate's id."""
+    return SimpleNamespace(labware_id=labware_id, success=True)
