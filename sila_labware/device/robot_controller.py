@@ -31,7 +31,7 @@ from ros_bridge.errors import BridgeError, BridgeTimeout
 from ros_bridge.goal_status import ActionGoal, ActionOutcome
 from ros_bridge.progress import CommandProgress, ProgressReport
 from ros_bridge.workcell import LabwareHandover, RobotStatus, WorkcellDescription
-from sila_labware.device.errors import CommandSequenceError, ParameterError
+from sila_labware.device.errors import CommandSequenceError, MotionFailed, TransferFailed
 from sila_labware.device.inventory import Inventory, in_hotel
 from sila_labware.device.robot_backend import RobotBackend
 from sila_labware.device.sequences import ManipulatorSequence, PreparedTransfer
@@ -47,24 +47,6 @@ logger = logging.getLogger(__name__)
 
 INTERMEDIATE_ACTIONS: tuple[str, ...] = ()
 """Fully qualified command identifiers this robot can run between pick and place: none yet."""
-
-
-class TransferFailed(Exception):
-    """GetLabware/PutLabware did not move the plate; `error_code` is the robot side's code."""
-
-    def __init__(self, error_code: str, message: str) -> None:
-        super().__init__(message)
-        self.error_code = error_code
-        self.message = message
-
-
-class MotionFailed(Exception):
-    """A base motion (dock, undock, drive) failed; `error_code` is the robot side's code."""
-
-    def __init__(self, error_code: str, message: str) -> None:
-        super().__init__(message)
-        self.error_code = error_code
-        self.message = message
 
 
 @dataclass(frozen=True)
@@ -392,15 +374,3 @@ class RobotController:
 def _describe_failure(what: str, outcome: ActionOutcome) -> str:
     reason = outcome.message or "no reason given"
     return f"{what} failed ({outcome.error_code}): {reason}"
-
-
-__all__ = [
-    "INTERMEDIATE_ACTIONS",
-    "CommandSequenceError",
-    "ControllerWaits",
-    "MotionFailed",
-    "ParameterError",
-    "ProgressReport",
-    "RobotController",
-    "TransferFailed",
-]

@@ -15,8 +15,8 @@ from sila2.framework.feature import Feature
 from sila2.framework.fully_qualified_identifier import FullyQualifiedCommandParameterIdentifier
 from sila2.server import ObservableCommandInstance
 
+from ros_bridge.progress import ProgressReport
 from sila_labware.device.errors import ParameterError
-from sila_labware.device.robot_controller import ProgressReport
 
 COMMAND_LIFETIME = timedelta(minutes=10)
 """How long a finished observable command's result stays available to clients, counted from its

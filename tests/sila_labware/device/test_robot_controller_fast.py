@@ -17,15 +17,10 @@ import pytest
 
 from ros_bridge.robot_link import RobotLink
 from ros_bridge.workcell import StationDescription, WorkcellDescription
-from sila_labware.device.errors import CommandSequenceError, ParameterError
+from sila_labware.device.errors import CommandSequenceError, MotionFailed, ParameterError, TransferFailed
 from sila_labware.device.inventory import GRIPPER, UNKNOWN, at_station, in_hotel
 from sila_labware.device.robot_backend import RobotBackend, StationBackend
-from sila_labware.device.robot_controller import (
-    ControllerWaits,
-    MotionFailed,
-    RobotController,
-    TransferFailed,
-)
+from sila_labware.device.robot_controller import ControllerWaits, RobotController
 from sila_labware.device.station_controller import StationController
 from sila_labware.device.validation import Handover
 from tests.helpers.fake_robot import (

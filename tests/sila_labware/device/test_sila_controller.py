@@ -10,8 +10,9 @@ import pytest
 
 from ros_bridge.robot_link import RobotLink
 from ros_bridge.workcell import StationDescription, WorkcellDescription
+from sila_labware.device.errors import MotionFailed
 from sila_labware.device.robot_backend import RobotBackend, StationBackend
-from sila_labware.device.robot_controller import MotionFailed, RobotController
+from sila_labware.device.robot_controller import RobotController
 
 WORKCELL = WorkcellDescription(
     stations=(StationDescription("reader", 1, "reader_poi"),),

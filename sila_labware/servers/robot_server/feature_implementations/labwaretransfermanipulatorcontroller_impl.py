@@ -13,8 +13,8 @@ from typing import TYPE_CHECKING, TypeVar
 
 from sila2.server import MetadataDict, ObservableCommandInstance
 
-from sila_labware.device.errors import CommandSequenceError, ParameterError
-from sila_labware.device.robot_controller import INTERMEDIATE_ACTIONS, MotionFailed, TransferFailed
+from sila_labware.device.errors import CommandSequenceError, MotionFailed, ParameterError, TransferFailed
+from sila_labware.device.robot_controller import INTERMEDIATE_ACTIONS
 from sila_labware.servers.sila_glue import (
     COMMAND_LIFETIME,
     handover_position,

@@ -14,8 +14,7 @@ from typing import TYPE_CHECKING
 from sila2.server import MetadataDict, ObservableCommandInstance
 
 from ros_bridge.workcell import RobotStatus
-from sila_labware.device.errors import CommandSequenceError, ParameterError
-from sila_labware.device.robot_controller import MotionFailed
+from sila_labware.device.errors import CommandSequenceError, MotionFailed, ParameterError
 from sila_labware.servers.sila_glue import COMMAND_LIFETIME, progress_reporter, validation_error
 
 from ..generated.mobilerobotcontroller import (
