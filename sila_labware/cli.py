@@ -29,6 +29,7 @@ from sila_labware.benchmarks.campaign_cli import (
     validate_bench,
     write_recorded_pictures,
 )
+from sila_labware.servers.refusal_log import install_refusal_log_filter
 
 if TYPE_CHECKING:
     from sila_labware.deployment.stack import Deployment
@@ -299,9 +300,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         level=logging.INFO if args.verbose else logging.WARNING,
         format="%(asctime)s %(levelname)s %(name)s: %(message)s",
     )
-    if not args.verbose:
-        # sila2 logs every defined error a client receives as a server-side traceback.
-        logging.getLogger("sila2").setLevel(logging.CRITICAL)
+    # sila2 logs every error a client receives as a traceback: a refusal becomes one WARNING line
+    install_refusal_log_filter()
     if args.command == "bluesky-demo":
         # bluesky's own loggers report every state change at INFO
         logging.getLogger("bluesky").setLevel(logging.INFO if args.verbose else logging.WARNING)

@@ -76,6 +76,7 @@ ALLOWED: dict[str, set[str]] = {
     "sila_labware.cli": {
         "ros_bridge",
         "ros_bridge.bluesky",
+        "sila_labware.servers",
         "sila_labware.deployment",
         "sila_labware.benchmarks",
     },

@@ -22,6 +22,7 @@ from sila2.server import SilaServer
 from ros_bridge.robot_link import RobotLink
 from ros_bridge.runtime import RosRuntime
 from ros_bridge.workcell import WorkcellDescription
+from sila_labware.servers.refusal_log import install_refusal_log_filter
 from sila_labware.servers.serving import start_sila_server
 from sila_labware.servers.tls import CertificateAuthority
 
@@ -50,6 +51,7 @@ def run_standalone(
 ) -> int:
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(levelname)s %(name)s: %(message)s")
+    install_refusal_log_filter()
     stop = threading.Event()
     signal.signal(signal.SIGINT, lambda *_: stop.set())
     signal.signal(signal.SIGTERM, lambda *_: stop.set())

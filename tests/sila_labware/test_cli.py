@@ -144,3 +144,48 @@ def assert_run_pictures(record_dir: Path) -> None:
     # the outline drawn around the detected marker is the detector's colour (255, 200, 0) in RGB
     outlined = cv2.cvtColor(cv2.imread(str(head_frames[0])), cv2.COLOR_BGR2RGB)
     assert (np.abs(outlined.astype(int) - (255, 200, 0)).sum(axis=2) < 30).sum() > 20
+
+
+def test_serve_logs_each_refusal_as_one_warning_line_without_a_traceback(tmp_path: Path) -> None:
+    """Refused input is the device doing its job: one WARNING line naming the command and the reason
+    (sila2 alone wrote an ERROR traceback for each, twice for an observable command)."""
+    port_base = free_port_base(4)
+    serve = subprocess.Popen(
+        [*CLI, "serve", "--insecure", "--port-base", str(port_base), "--no-discovery"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert serve.stdout is not None
+        while (line := serve.stdout.readline()) and line.strip() != "serving; Ctrl-C stops":
+            pass
+        robot = SilaClient("127.0.0.1", port_base, insecure=True)
+        manipulator = robot.LabwareTransferManipulatorController
+        refusals = [
+            lambda: manipulator.GetLabware(
+                HandoverPosition={"Position": "station_a", "SubPosition": 1}, IntermediateActions=[]
+            ).get_responses(),
+            lambda: manipulator.PrepareForOutput(
+                HandoverPosition={"Position": "oven", "SubPosition": 1}, InternalPosition=1
+            ).get_responses(),
+            lambda: robot.MobileRobotController.DriveToPointOfInterest(
+                PointOfInterest="attic"
+            ).get_responses(),
+        ]
+        for refuse in refusals:
+            with pytest.raises(Exception):  # noqa: B017 - which SiLA error is the servers' tests' concern
+                refuse()
+        serve.send_signal(signal.SIGINT)
+        assert serve.wait(timeout=10) == 0
+        log = serve.stderr.read() if serve.stderr else ""
+    finally:
+        if serve.poll() is None:
+            serve.kill()
+            serve.wait()
+    assert "Traceback" not in log, log[-3000:]
+    refused = [line for line in log.splitlines() if " refused: " in line]
+    assert all(" WARNING " in line for line in refused), refused
+    assert "NoneType: None" not in log
+    for command in ("GetLabware", "PrepareForOutput", "DriveToPointOfInterest"):
+        assert sum(command in line for line in refused) == 1, (command, refused)
