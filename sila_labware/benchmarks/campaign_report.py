@@ -1,9 +1,11 @@
 """Pictures for a campaign report: charts of the success table and phase times, and one run's frames.
 
-Why OpenCV: it is already a dependency (matplotlib is not), and bar charts need only rectangles
-and text. This is a reporting tool beside the device stack: nothing on the SiLA -> ROS path
-imports it, so the rule "sila_labware never imports cv2" holds for the device itself; cv2 is
-imported only when a report is written.
+Charts are drawn with matplotlib (a `Figure` on the Agg canvas: headless, and no pyplot, so no
+global figure state is touched when a campaign writes its report); the camera pictures (image
+strip, GIF) with OpenCV, which reads and resizes the recorded frames. This is a reporting tool
+beside the device stack: nothing on the SiLA -> ROS path imports it, so the rule "sila_labware
+never imports cv2" holds for the device itself; cv2 and matplotlib are imported only when a
+report is written.
 
 Frames come from the sim node's run recorder (tiago_sim.measuring.run_recorder): ``overview_NNNN.png`` and
 ``head_NNNN.png`` (head frames with the detected marker outlined).
@@ -13,20 +15,26 @@ Threads: any; pure file in, file out.
 from __future__ import annotations
 
 import logging
+import textwrap
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
 logger = logging.getLogger(__name__)
 
-WHITE = (255, 255, 255)
-INK = (40, 40, 40)
-GREEN = (80, 170, 60)
-RED = (60, 60, 200)  # BGR
-BLUE = (190, 120, 40)
-GREY = (170, 170, 170)
-FONT = 0  # cv2.FONT_HERSHEY_SIMPLEX
+DELIVERED_COLOUR = "#3b8f3b"
+FAILED_COLOUR = "#c44536"
+SIMULATED_COLOUR = "#2f6fad"
+WALL_COLOUR = "#a5a5a5"
+INK = "#333333"
+FAINT = "#dddddd"
+CHART_DPI = 150
+PHASE_LABEL_WIDTH = 24  # characters per line before a phase name wraps (at its " + ")
 
 
 def _cv2() -> Any:
@@ -35,62 +43,129 @@ def _cv2() -> Any:
     return cv2
 
 
-def _text(canvas: np.ndarray, text: str, origin: tuple[int, int], scale: float = 0.5, color=INK) -> None:
-    _cv2().putText(canvas, text, origin, FONT, scale, color, 1, _cv2().LINE_AA)
+def _figure(width_in: float, height_in: float) -> Figure:
+    """A figure on its own Agg canvas, independent of pyplot's current figure and backend."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    figure = Figure(figsize=(width_in, height_in), dpi=CHART_DPI, layout="constrained")
+    FigureCanvasAgg(figure)
+    figure.set_facecolor("white")
+    return figure
 
 
-def _bar_chart(
-    title: str, labels: list[str], series: list[tuple[str, Any, list[float]]], unit: str
-) -> np.ndarray:
-    """Horizontal bars, one group per label, one bar per series (name, BGR colour, values)."""
-    cv2 = _cv2()
-    row = 18 * len(series) + 14
-    width, left, right, top = 760, 330, 90, 60
-    height = top + row * len(labels) + 40
-    canvas = np.full((height, width, 3), 255, np.uint8)
-    _text(canvas, title, (12, 26), 0.62)
-    largest = max((v for _, _, values in series for v in values), default=1.0) or 1.0
-    scale = (width - left - right) / largest
-    for legend_index, (name, color, _) in enumerate(series):
-        x = 12 + 190 * legend_index
-        cv2.rectangle(canvas, (x, 38), (x + 14, 50), color[0] if isinstance(color, list) else color, -1)
-        _text(canvas, name, (x + 20, 50), 0.45)
-    for index, label in enumerate(labels):
-        y0 = top + index * row
-        _text(canvas, label[:44], (12, y0 + row // 2 + 4), 0.45)
-        for series_index, (_, color, values) in enumerate(series):
-            value = values[index]
-            y = y0 + 4 + 18 * series_index
-            bar_color = color[index] if isinstance(color, list) else color
-            cv2.rectangle(canvas, (left, y), (left + max(1, int(value * scale)), y + 14), bar_color, -1)
-            _text(canvas, f"{value:g} {unit}".strip(), (left + int(value * scale) + 6, y + 12), 0.42)
-    cv2.line(canvas, (left, top - 4), (left, height - 36), GREY, 1)
-    return canvas
+def _style(axes: Axes, title: str) -> None:
+    """Horizontal bars read top-down; a light grid along the values, no box."""
+    axes.set_title(title, loc="left", fontsize=10, color=INK, fontweight="bold")
+    axes.invert_yaxis()
+    axes.grid(axis="x", color=FAINT, linewidth=0.8)
+    axes.set_axisbelow(True)
+    for side in ("top", "right", "left"):
+        axes.spines[side].set_visible(False)
+    axes.spines["bottom"].set_color("#999999")
+    axes.tick_params(axis="y", length=0, labelsize=9, labelcolor=INK)
+    axes.tick_params(axis="x", labelsize=8, colors="#666666")
 
 
-def success_chart(summary: dict[str, Any]) -> np.ndarray:
-    failures = summary["failures"]
-    labels = ["delivered"] + [f"failed: {cause}" for cause in failures]
-    counts = [float(summary["successes"])] + [float(count) for count in failures.values()]
-    title = (
-        f"{summary['trials']} transfers, {summary['successes']} delivered "
-        f"({100 * summary['success_rate']:.1f} %), seed {summary['seed']}"
+def _label_bars(axes: Axes, bars: Any, texts: list[str]) -> None:
+    """The value beside each bar's end, inside the axes (the x range leaves room for it)."""
+    for bar, text in zip(bars, texts, strict=True):
+        axes.annotate(
+            text,
+            (bar.get_width(), bar.get_y() + bar.get_height() / 2),
+            xytext=(4, 0),
+            textcoords="offset points",
+            va="center",
+            fontsize=8,
+            color=INK,
+        )
+
+
+def success_chart(summary: dict[str, Any]) -> Figure:
+    """Left: delivered against failed, of all trials. Right: the failures by cause, on a scale
+    of their own, so that one failure in two hundred is still visible."""
+    from matplotlib.ticker import MaxNLocator
+
+    trials, successes = int(summary["trials"]), int(summary["successes"])
+    failures = {cause: int(count) for cause, count in summary["failures"].items()}
+    figure = _figure(9.0, 3.0)
+    outcome_axes, cause_axes = figure.subplots(1, 2, width_ratios=(1.0, 1.1))
+    figure.suptitle(
+        f"{trials} transfers, {successes} delivered ({100 * summary['success_rate']:.1f} %), "
+        f"seed {summary['seed']}",
+        x=0.01,
+        ha="left",
+        fontsize=11,
+        color=INK,
     )
-    colors = [GREEN] + [RED] * len(failures)
-    return _bar_chart(title, labels, [("trials", colors, counts)], "")
+
+    outcomes = [successes, trials - successes]
+    bars = outcome_axes.barh(
+        ["delivered", "failed"], outcomes, color=[DELIVERED_COLOUR, FAILED_COLOUR], height=0.55
+    )
+    _style(outcome_axes, "outcome")
+    outcome_axes.set_xlim(0, max(trials, 1) * 1.18)
+    outcome_axes.set_xlabel("trials", fontsize=8, color="#666666")
+    outcome_axes.xaxis.set_major_locator(MaxNLocator(nbins=5, integer=True))
+    _label_bars(
+        outcome_axes,
+        bars,
+        [f"{count} ({100 * count / trials:.1f} %)" if trials else "0" for count in outcomes],
+    )
+
+    causes = list(failures)
+    bars = cause_axes.barh(causes, [failures[c] for c in causes], color=FAILED_COLOUR, height=0.55)
+    _style(cause_axes, "failures by cause")
+    cause_axes.set_xlim(0, max(max(failures.values(), default=0), 1) * 1.25)
+    cause_axes.set_xlabel("trials", fontsize=8, color="#666666")
+    cause_axes.xaxis.set_major_locator(MaxNLocator(nbins=4, integer=True))
+    _label_bars(cause_axes, bars, [str(failures[c]) for c in causes])
+    return figure
 
 
-def phase_chart(summary: dict[str, Any]) -> np.ndarray:
+def _phase_label(name: str) -> str:
+    """Long phase names ("A.PrepareForOutput + Robot.PrepareForInput") on two lines."""
+    return "\n".join(textwrap.wrap(name, PHASE_LABEL_WIDTH, break_on_hyphens=False)) or name
+
+
+def _seconds(value: float) -> str:
+    """Bar labels: a station's instant step shows as 0.03 s, not as 0.0 s."""
+    return f"{value:.2f} s" if 0 < value < 0.095 else f"{value:.1f} s"
+
+
+def phase_chart(summary: dict[str, Any]) -> Figure:
+    """Median simulated and wall seconds per phase of the standard sequence, and for the whole
+    transfer (delivered trials), as paired bars."""
     phases = summary["phases"]
-    labels = list(phases) + ["whole transfer"]
-    sim = [round(phases[n]["sim_seconds_median"], 1) for n in phases] + [
-        round(summary["sim_seconds_median"], 1)
-    ]
-    wall = [round(phases[n]["wall_seconds_median"], 1) for n in phases] + [
-        round(summary["wall_seconds_median"], 1)
-    ]
-    title = f"median time per phase (real-time factor {summary['realtime_factor']:.1f})"
-    return _bar_chart(title, labels, [("simulated s", BLUE, sim), ("wall s", GREY, wall)], "s")
+    labels = [_phase_label(name) for name in phases] + ["whole transfer\n(delivered)"]
+    simulated = [phases[name]["sim_seconds_median"] for name in phases] + [summary["sim_seconds_median"]]
+    wall = [phases[name]["wall_seconds_median"] for name in phases] + [summary["wall_seconds_median"]]
+    figure = _figure(9.0, 0.55 * len(labels) + 1.3)
+    axes = figure.subplots()
+    factor = summary["realtime_factor"]
+    figure.suptitle(
+        f"Median time per phase, simulated and wall clock (real-time factor {factor:.1f})",
+        x=0.01,
+        ha="left",
+        fontsize=11,
+        color=INK,
+    )
+    rows = np.arange(len(labels))
+    height = 0.38
+    for offset, values, colour, name in (
+        (-height / 2, simulated, SIMULATED_COLOUR, "simulated"),
+        (height / 2, wall, WALL_COLOUR, "wall clock"),
+    ):
+        bars = axes.barh(rows + offset, values, height=height, color=colour, label=name)
+        _label_bars(axes, bars, [_seconds(value) for value in values])
+    _style(axes, "")
+    axes.set_yticks(rows, labels)
+    axes.set_xlim(0, max(simulated + wall + [1.0]) * 1.12)
+    axes.set_xlabel("seconds (median over trials)", fontsize=8, color="#666666")
+    if len(labels) > 1:  # the whole transfer is a sum, not a phase: set it apart
+        axes.axhline(len(labels) - 1.5, color="#999999", linewidth=0.8, linestyle=(0, (4, 3)))
+    axes.legend(loc="upper right", fontsize=8, frameon=False)
+    return figure
 
 
 def _frames(directory: Path, prefix: str) -> list[Path]:
@@ -154,15 +229,13 @@ def write_run_pictures(frames_dir: Path, out_dir: Path) -> list[Path]:
 
 def write_charts(summary: dict[str, Any], out_dir: Path) -> list[Path]:
     """`success_by_cause.png` and `time_per_phase.png`."""
-    cv2 = _cv2()
     out_dir.mkdir(parents=True, exist_ok=True)
     written = []
-    for name, image in (
+    for name, figure in (
         ("success_by_cause.png", success_chart(summary)),
         ("time_per_phase.png", phase_chart(summary)),
     ):
         path = out_dir / name
-        if not cv2.imwrite(str(path), image):
-            raise OSError(f"could not write {path}")
+        figure.savefig(path, dpi=CHART_DPI, facecolor="white")
         written.append(path)
     return written

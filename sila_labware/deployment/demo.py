@@ -1,12 +1,14 @@
-"""The demo transfer, done the way a lab scheduler would: as a plain SiLA client of our servers.
+"""The demo transfer, done the way a lab scheduler would: as a SiLA client of our servers.
 
-Moves the plate found on the first station to a free nest of the second, in the standard's order:
-A.PrepareForOutput + Robot.PrepareForInput, Robot.GetLabware, A.LabwareRemoved,
-B.PrepareForInput + Robot.PrepareForOutput, Robot.PutLabware, B.LabwareDelivered.
-Success is judged from physics ground truth (/check_placement through the bridge), never from
-what the commands reported.
+Moves the plate found on the first station to a free nest of the second through
+`LabwareTransferClient.transfer`, which sends the standard's sequence (A.PrepareForOutput +
+Robot.PrepareForInput, Robot.GetLabware, A.LabwareRemoved, B.PrepareForInput +
+Robot.PrepareForOutput, Robot.PutLabware, B.LabwareDelivered). Each step is timed in wall and
+simulated seconds (the robot's /robot_state stamp, read through the bridge). Success is judged from
+physics ground truth (/check_placement through the bridge), never from what the commands reported.
 
-Threads: runs on the caller's thread; sila2's client threads deliver execution infos.
+Threads: runs on the caller's thread, where the client also calls back with progress; sila2's
+client threads deliver execution infos.
 """
 
 from __future__ import annotations
@@ -15,23 +17,17 @@ import logging
 import math
 import sys
 import time
-from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from typing import Any, TextIO
 
-from sila2.client import SilaClient
-
+from ros_bridge.robot_link import RobotLink
 from ros_bridge.workcell import PlacementCheck
-from sila_labware.deployment.stack import Deployment, ServedServer
+from sila_labware.client import StepProgress
+from sila_labware.client.console import ProgressLine
+from sila_labware.deployment.clients import transfer_client
+from sila_labware.deployment.stack import Deployment
 
 logger = logging.getLogger(__name__)
-
-COMMAND_TIMEOUT_S = 900.0
-# The client notices a finished command within DONE_CHECK_S: every step waits for the previous one,
-# and the idle robot's clock runs at 1x meanwhile (checked every 0.2 s, the six steps of a transfer
-# lost about 0.6 s of wall and simulated time). The progress line is redrawn less often.
-DONE_CHECK_S = 0.02
-PROGRESS_REDRAW_S = 0.2
 
 
 @dataclass
@@ -58,59 +54,27 @@ class DemoReport:
         return asdict(self)
 
 
-def connect(deployment: Deployment, served: ServedServer) -> SilaClient:
-    if deployment.ca_file is None:
-        return SilaClient(served.host, served.port, insecure=True)
-    return SilaClient(served.host, served.port, root_certs=deployment.ca_file.read_bytes())
+class StepClock:
+    """An `on_progress` callback: times every finished step in wall and simulated seconds, and
+    draws the progress line. Simulated time is the robot's clock, read when a step begins and ends."""
 
+    def __init__(self, link: RobotLink, progress_line: ProgressLine) -> None:
+        self._link = link
+        self._progress_line = progress_line
+        self._sim_started_s = 0.0
+        self.steps: list[StepTiming] = []
 
-class ProgressLine:
-    """One live line on a terminal stream: step name, progress bar, remaining time."""
-
-    def __init__(self, stream: TextIO | None) -> None:
-        self._stream = stream
-        self._interactive = bool(stream is not None and stream.isatty())
-
-    def show(self, step: str, progress: float, remaining_s: float | None) -> None:
-        if self._stream is None or not self._interactive:
-            return
-        filled = int(round(20 * progress))
-        remaining = f"{remaining_s:5.1f} s left" if remaining_s is not None else ""
-        self._stream.write(
-            f"\r{step:<48} [{'#' * filled}{'.' * (20 - filled)}] {100 * progress:5.1f} % {remaining}"
-        )
-        self._stream.flush()
-
-    def done(self, step: str, wall_s: float, sim_s: float) -> None:
-        if self._stream is None:
-            return
-        prefix = "\r" if self._interactive else ""
-        self._stream.write(
-            f"{prefix}{step:<48} done in {wall_s:6.1f} s wall, {sim_s:6.1f} s simulated{' ' * 12}\n"
-        )
-        self._stream.flush()
-
-
-def run_commands(commands: list[Callable[[], Any]], step: str, progress_line: ProgressLine) -> None:
-    """Start observable commands together and wait for all; their errors propagate."""
-    instances = [command() for command in commands]
-    deadline = time.monotonic() + COMMAND_TIMEOUT_S
-    redraw_at = 0.0
-    while not all(instance.done for instance in instances):
-        now = time.monotonic()
-        if now > deadline:
-            raise TimeoutError(f"{step}: not finished after {COMMAND_TIMEOUT_S:.0f} s")
-        if now >= redraw_at:
-            redraw_at = now + PROGRESS_REDRAW_S
-            progresses = [instance.progress or 0.0 for instance in instances]
-            remaining = [instance.estimated_remaining_time for instance in instances]
-            remaining_s = max(
-                (value.total_seconds() for value in remaining if value is not None), default=None
+    def __call__(self, record: StepProgress) -> None:
+        if record.elapsed_s == 0.0:  # the step's first record, before its commands are sent
+            self._sim_started_s = self._link.robot_status().stamp_s
+        if record.done:
+            timing = StepTiming(
+                record.step, self._link.robot_status().stamp_s - self._sim_started_s, record.elapsed_s
             )
-            progress_line.show(step, min(progresses), remaining_s)
-        time.sleep(DONE_CHECK_S)
-    for instance in instances:
-        instance.get_responses()  # raises the command's SiLA error, if any
+            self.steps.append(timing)
+            self._progress_line.done(timing.name, timing.wall_seconds, timing.sim_seconds)
+        else:
+            self._progress_line.show(record.step, record.progress, record.remaining_s)
 
 
 def run_demo(deployment: Deployment, progress_stream: TextIO | None = sys.stderr) -> DemoReport:
@@ -129,53 +93,28 @@ def run_demo(deployment: Deployment, progress_stream: TextIO | None = sys.stderr
     if plate_nest is None or free_nest is None:
         report.error = f"need a plate on {source.name} and a free nest on {destination.name}"
         return report
-    report.labware_id = plate_nest.labware_id
+    plate_id = plate_nest.labware_id
+    report.labware_id = plate_id
     report.source = f"{source.name}/{plate_nest.sub_position}"
     report.destination = f"{destination.name}/{free_nest.sub_position}"
-    pick = (source.name, plate_nest.sub_position)
-    place = (destination.name, free_nest.sub_position)
 
-    robot = connect(deployment, deployment.robot_server()).LabwareTransferManipulatorController
-    site_a = connect(deployment, deployment.station_server(source.name)).LabwareTransferSiteController
-    site_b = connect(deployment, deployment.station_server(destination.name)).LabwareTransferSiteController
-    plate_id = plate_nest.labware_id
-    plan: list[tuple[str, list[Callable[[], Any]]]] = [
-        (
-            "A.PrepareForOutput + Robot.PrepareForInput",
-            [
-                lambda: site_a.PrepareForOutput(HandoverPosition=pick, InternalPosition=1),
-                lambda: robot.PrepareForInput(
-                    HandoverPosition=pick, InternalPosition=1, LabwareType="", LabwareUniqueID=plate_id
-                ),
-            ],
-        ),
-        ("Robot.GetLabware", [lambda: robot.GetLabware(HandoverPosition=pick, IntermediateActions=[])]),
-        ("A.LabwareRemoved", [lambda: site_a.LabwareRemoved(HandoverPosition=pick)]),
-        (
-            "B.PrepareForInput + Robot.PrepareForOutput",
-            [
-                lambda: site_b.PrepareForInput(
-                    HandoverPosition=place, InternalPosition=1, LabwareType="", LabwareUniqueID=plate_id
-                ),
-                lambda: robot.PrepareForOutput(HandoverPosition=place, InternalPosition=1),
-            ],
-        ),
-        ("Robot.PutLabware", [lambda: robot.PutLabware(HandoverPosition=place, IntermediateActions=[])]),
-        ("B.LabwareDelivered", [lambda: site_b.LabwareDelivered(HandoverPosition=place)]),
-    ]
-    progress_line = ProgressLine(progress_stream)
+    clock = StepClock(link, ProgressLine(progress_stream))
     wall_start, sim_start = time.monotonic(), link.robot_status().stamp_s
     try:
-        for step, commands in plan:
-            step_wall, step_sim = time.monotonic(), link.robot_status().stamp_s
-            run_commands(commands, step, progress_line)
-            timing = StepTiming(step, link.robot_status().stamp_s - step_sim, time.monotonic() - step_wall)
-            report.steps.append(timing)
-            progress_line.done(step, timing.wall_seconds, timing.sim_seconds)
+        with transfer_client(deployment) as client:
+            client.transfer(
+                (source.name, plate_nest.sub_position),
+                (destination.name, free_nest.sub_position),
+                labware_id=plate_id,
+                on_progress=clock,
+            )
     except Exception as error:  # noqa: BLE001 - the report says what failed; exit code follows
+        # the type names the defined error (LabwareNotPicked ...); the message keeps the robot
+        # side's error code (MARKER_NOT_FOUND ...), which the campaign classifies failures by
         report.error = f"{type(error).__name__}: {error}"
         if progress_stream is not None:
             progress_stream.write(f"\nfailed: {report.error}\n")
+    report.steps = clock.steps
     report.wall_seconds = time.monotonic() - wall_start
     report.sim_seconds = link.robot_status().stamp_s - sim_start
     placement = link.check_placement(plate_id, destination.name, free_nest.sub_position)

@@ -87,6 +87,19 @@ def test_disturbances_are_seeded_and_move_the_true_world_only() -> None:
         ("physics check: the plate is not in station_b/1; it is at floor", "positioning"),
         ("physics check: the plate rests in station_b/1 but outside the nest's tolerance", "positioning"),
         ("TimeoutError: Robot.GetLabware: not finished after 900 s", "other"),
+        # as the demo writes them since it runs the transfer through LabwareTransferClient
+        (
+            "LabwareNotPicked: Robot.GetLabware: GetLabware failed (MARKER_NOT_FOUND): marker not found: 3",
+            "perception",
+        ),
+        (
+            "UndefinedServerError: Robot.PrepareForOutput (step B.PrepareForInput + Robot.PrepareForOutput): "
+            "RuntimeError - PrepareForOutput failed while driving: driving to station_b_work failed "
+            "(MOTION_FAILED): stalled",
+            "navigation",
+        ),
+        ("LabwareNotPlaced: Robot.PutLabware: PutLabware failed (MOTION_FAILED): arm stalled", "positioning"),
+        ("StepTimeout: Robot.PutLabware: not finished after 900 s: Robot.PutLabware", "other"),
     ],
 )
 def test_every_failure_message_gets_a_cause(error: str, cause: str) -> None:
