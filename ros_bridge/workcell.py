@@ -1,41 +1,16 @@
 """Plain-Python views of what the robot side reports, so layers above never touch ROS messages.
 
 These are immutable snapshots built from labware_interfaces messages (see `robot_link.py`);
-they hold SI units (m, rad) like the messages they come from.
+they hold SI units (m, rad) like the messages they come from. Nests, hotel slots and the
+readings of their sensors are the labware model's (`labware_model`); the workcell the robot
+serves is its `WorkcellDescription`.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-
-@dataclass(frozen=True)
-class StationDescription:
-    """A station the robot serves: its name, number of nests and the POI to work from."""
-
-    name: str
-    sub_positions: int
-    poi: str
-
-
-@dataclass(frozen=True)
-class WorkcellDescription:
-    """Everything the robot can serve, as the world file describes it."""
-
-    stations: tuple[StationDescription, ...]
-    hotel_slots: int
-    pois: tuple[str, ...]
-    dock_poi: str
-
-    def station(self, name: str) -> StationDescription | None:
-        return next((station for station in self.stations if station.name == name), None)
-
-
-@dataclass(frozen=True)
-class HotelSlotContent:
-    index: int
-    labware_id: str
-    labware_type: str
+from labware_model.readings import HotelSlotReading
 
 
 @dataclass(frozen=True)
@@ -48,7 +23,7 @@ class RobotStatus:
     x_m: float
     y_m: float
     theta_rad: float
-    hotel: tuple[HotelSlotContent, ...]
+    hotel: tuple[HotelSlotReading, ...]
     held_labware_id: str
     stamp_s: float = 0.0
     """The message stamp in seconds: the robot side's clock (simulated time in simulation)."""
@@ -61,25 +36,3 @@ class RobotStatus:
     def onboard_labware_ids(self) -> tuple[str, ...]:
         held = (self.held_labware_id,) if self.held_labware_id else ()
         return tuple(slot.labware_id for slot in self.hotel if slot.labware_id) + held
-
-
-@dataclass(frozen=True)
-class NestOccupancy:
-    """One nest of a station, as the station's sensor reports it."""
-
-    station: str
-    sub_position: int
-    occupied: bool
-    labware_id: str
-
-
-@dataclass(frozen=True)
-class PlacementCheck:
-    """Physics ground truth about one plate (for success checks only, never for control)."""
-
-    found: bool
-    in_nest: bool
-    position_error_m: float
-    yaw_error_rad: float
-    location: str
-    outside: str = ""  # in the expected nest but outside its tolerance: the limits it missed

@@ -21,7 +21,8 @@ from typing import Any, TextIO
 
 from sila2.client import SilaClient
 
-from ros_bridge.workcell import PlacementCheck
+from labware_model.holders import Nest, location_text
+from labware_model.readings import PlacementCheck
 from sila_labware.deployment.stack import Deployment, ServedServer
 
 logger = logging.getLogger(__name__)
@@ -123,22 +124,23 @@ def run_demo(deployment: Deployment, progress_stream: TextIO | None = sys.stderr
         report.error = "the world needs at least two stations"
         return report
     source, destination = stations[0], stations[1]
-    nests = link.nest_occupancies()
-    plate_nest = next((n for n in nests if n.station == source.name and n.occupied), None)
-    free_nest = next((n for n in nests if n.station == destination.name and not n.occupied), None)
-    if plate_nest is None or free_nest is None:
+    nests = link.nest_readings()
+    plate_reading = next((n for n in nests if n.nest.station == source.name and n.occupied), None)
+    free_reading = next((n for n in nests if n.nest.station == destination.name and not n.occupied), None)
+    if plate_reading is None or free_reading is None:
         report.error = f"need a plate on {source.name} and a free nest on {destination.name}"
         return report
-    report.labware_id = plate_nest.labware_id
-    report.source = f"{source.name}/{plate_nest.sub_position}"
-    report.destination = f"{destination.name}/{free_nest.sub_position}"
-    pick = (source.name, plate_nest.sub_position)
-    place = (destination.name, free_nest.sub_position)
+    plate_nest, free_nest = plate_reading.nest, free_reading.nest
+    report.labware_id = plate_reading.labware_id
+    report.source = str(plate_nest)
+    report.destination = str(free_nest)
+    pick = (plate_nest.station, plate_nest.sub_position)  # the SiLA HandoverPosition structure
+    place = (free_nest.station, free_nest.sub_position)
 
     robot = connect(deployment, deployment.robot_server()).LabwareTransferManipulatorController
     site_a = connect(deployment, deployment.station_server(source.name)).LabwareTransferSiteController
     site_b = connect(deployment, deployment.station_server(destination.name)).LabwareTransferSiteController
-    plate_id = plate_nest.labware_id
+    plate_id = plate_reading.labware_id
     plan: list[tuple[str, list[Callable[[], Any]]]] = [
         (
             "A.PrepareForOutput + Robot.PrepareForInput",
@@ -178,13 +180,13 @@ def run_demo(deployment: Deployment, progress_stream: TextIO | None = sys.stderr
             progress_stream.write(f"\nfailed: {report.error}\n")
     report.wall_seconds = time.monotonic() - wall_start
     report.sim_seconds = link.robot_status().stamp_s - sim_start
-    placement = link.check_placement(plate_id, destination.name, free_nest.sub_position)
+    placement = link.check_placement(plate_id, free_nest)
     report.success = placement.in_nest and not report.error
     if placement.found:
         report.plate_position_error_mm = 1000.0 * placement.position_error_m
         report.plate_yaw_error_deg = math.degrees(placement.yaw_error_rad)
     if not placement.in_nest and not report.error:
-        report.error = misplacement(report.destination, placement)
+        report.error = misplacement(free_nest, placement)
     return report
 
 
@@ -192,11 +194,10 @@ def run_demo(deployment: Deployment, progress_stream: TextIO | None = sys.stderr
 MISPLACED = "physics check: "
 
 
-def misplacement(destination: str, placement: PlacementCheck) -> str:
+def misplacement(destination: Nest, placement: PlacementCheck) -> str:
     """Why the physics check refused a delivery the commands reported as done."""
-    station, _, sub = destination.partition("/")
-    if placement.location != f"station:{station}:{sub}":
-        return f"{MISPLACED}the plate is not in {destination}; it is at {placement.location}"
+    if placement.location != destination:
+        return f"{MISPLACED}the plate is not in {destination}; it is at {location_text(placement.location)}"
     return (
         f"{MISPLACED}the plate rests in {destination} but outside the nest's tolerance: "
         f"{placement.outside or 'limit not reported'} ({1000.0 * placement.position_error_m:.1f} mm "
