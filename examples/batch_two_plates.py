@@ -22,7 +22,6 @@ from sila_labware.client.console import (
     add_connection_arguments,
     client_from_arguments,
     handover,
-    handover_text,
 )
 
 
@@ -47,12 +46,12 @@ def main(argv: Sequence[str] | None = None) -> int:
                 parser.error(f"the robot carries at most {robot.internal_positions()} plates")
             # internal positions (hotel slots) are numbered from 1: plate k rides in position k
             for slot, (source, _, plate) in enumerate(moves, start=1):
-                print(f"picking {plate} from {handover_text(source)} into internal position {slot}")
+                print(f"picking {plate} from {source} into internal position {slot}")
                 robot.pick(source, internal_position=slot, labware_id=plate, on_progress=StepPrinter())
             for item in robot.onboard_labware():
                 print(f"on board: {item.labware_id} in internal position {item.internal_position}")
             for slot, (_, destination, plate) in enumerate(moves, start=1):
-                print(f"placing {plate} from internal position {slot} into {handover_text(destination)}")
+                print(f"placing {plate} from internal position {slot} into {destination}")
                 robot.place(destination, internal_position=slot, on_progress=StepPrinter())
     except LabwareTransferError as error:
         print(f"failed: {type(error).__name__}: {error}", file=sys.stderr)

@@ -22,20 +22,13 @@ from bluesky import RunEngine
 from bluesky.utils import RunEngineInterrupted
 from ophyd.sim import SynAxis, SynGauss
 
-from ros_bridge.bluesky import LabwareTransferRobot, NestSite, sample_exchange_plan
+from ros_bridge.bluesky import LabwareTransferRobot, sample_exchange_plan
 from ros_bridge.robot_link import RobotLink
 from ros_bridge.runtime import RosRuntime
+from sila_labware.client.console import handover
 
 MEASURE_POSITION_M = 0.26  # the beamline paper moved its stage by 26 cm
 LOAD_POSITION_M = 0.0
-
-
-def nest(text: str) -> NestSite:
-    """ "station_a/1" -> NestSite("station_a", 1); an argparse type."""
-    station, _, sub_position = text.rpartition("/")
-    if not station or not sub_position.isdigit():
-        raise argparse.ArgumentTypeError(f"{text!r} is not STATION/N (e.g. station_a/1)")
-    return NestSite(station, int(sub_position))
 
 
 def print_robot_events(name: str, document: dict[str, Any]) -> None:
@@ -55,8 +48,8 @@ def print_robot_events(name: str, document: dict[str, Any]) -> None:
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--domain-id", type=int, required=True, help="the robot side's ROS domain")
-    parser.add_argument("--storage", type=nest, default=NestSite("station_a", 1), metavar="STATION/N")
-    parser.add_argument("--beam", type=nest, default=NestSite("station_b", 1), metavar="STATION/N")
+    parser.add_argument("--storage", type=handover, default="station_a/1", metavar="STATION/N")
+    parser.add_argument("--beam", type=handover, default="station_b/1", metavar="STATION/N")
     parser.add_argument("--plate", default="plate_001")
     parser.add_argument("--hotel-slot", type=int, default=1, help="the robot's slot that carries the plate")
     args = parser.parse_args(argv)

@@ -20,26 +20,23 @@ from sila_labware.client.console import (
     add_connection_arguments,
     client_from_arguments,
     handover,
-    handover_text,
 )
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     add_connection_arguments(parser)
-    parser.add_argument("--source", type=handover, default=("station_a", 1), metavar="STATION/N")
-    parser.add_argument("--destination", type=handover, default=("station_b", 1), metavar="STATION/N")
+    parser.add_argument("--source", type=handover, default="station_a/1", metavar="STATION/N")
+    parser.add_argument("--destination", type=handover, default="station_b/1", metavar="STATION/N")
     parser.add_argument("--plate", default="plate_001", help="the plate's id (announced to both devices)")
     args = parser.parse_args(argv)
 
     try:
         with client_from_arguments(args) as robot:
-            print(
-                f"moving {args.plate} from {handover_text(args.source)} to {handover_text(args.destination)}"
-            )
+            print(f"moving {args.plate} from {args.source} to {args.destination}")
             robot.transfer(args.source, args.destination, labware_id=args.plate, on_progress=StepPrinter())
             where = robot.locate(args.plate)
-            print(f"the robot's inventory has {args.plate} at {where.position}/{where.index}")
+            print(f"the robot's inventory has {args.plate} at {where.location}")
             print("docking")
             robot.dock(on_progress=StepPrinter())
     except LabwareTransferError as error:

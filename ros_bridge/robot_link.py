@@ -18,19 +18,15 @@ from labware_interfaces.action import Dock, GetLabware, NavigateToPoi, PutLabwar
 from labware_interfaces.msg import RobotState, StationStates
 from labware_interfaces.srv import CheckPlacement, DescribeWorkcell
 
+from labware_model.holders import HotelSlot, Nest, parse_location
+from labware_model.readings import HotelSlotReading, NestReading, PlacementCheck
+from labware_model.workcell import StationDescription, WorkcellDescription
 from ros_bridge.actions import ActionCaller, ActionGoal, GoalProgress
+from ros_bridge.errors import BridgeError
 from ros_bridge.runtime import RosRuntime
 from ros_bridge.services import ServiceCaller
 from ros_bridge.topics import TopicMirror
-from ros_bridge.workcell import (
-    HotelSlotContent,
-    LabwareHandover,
-    NestOccupancy,
-    PlacementCheck,
-    RobotStatus,
-    StationDescription,
-    WorkcellDescription,
-)
+from ros_bridge.workcell import LabwareHandover, RobotStatus
 
 logger = logging.getLogger(__name__)
 
@@ -46,16 +42,17 @@ def robot_status_from_message(message: RobotState) -> RobotStatus:
         y_m=float(message.base_pose.y),
         theta_rad=float(message.base_pose.theta),
         hotel=tuple(
-            HotelSlotContent(int(slot.index), slot.labware_id, slot.labware_type) for slot in message.hotel
+            HotelSlotReading(HotelSlot(int(slot.index)), slot.labware_id, slot.labware_type)
+            for slot in message.hotel
         ),
         held_labware_id=message.held_labware_id,
         stamp_s=message.stamp.sec + message.stamp.nanosec * 1e-9,
     )
 
 
-def nest_occupancies_from_message(message: StationStates) -> tuple[NestOccupancy, ...]:
+def nest_readings_from_message(message: StationStates) -> tuple[NestReading, ...]:
     return tuple(
-        NestOccupancy(nest.station, int(nest.sub_position), bool(nest.occupied), nest.labware_id)
+        NestReading(Nest(nest.station, int(nest.sub_position)), bool(nest.occupied), nest.labware_id)
         for nest in message.nests
     )
 
@@ -125,16 +122,26 @@ class RobotLink:
         )
 
     def check_placement(
-        self, labware_id: str, station: str = "", sub_position: int = 0, timeout_s: float = 5.0
+        self, labware_id: str, nest: Nest | None = None, timeout_s: float = 5.0
     ) -> PlacementCheck:
-        request = CheckPlacement.Request(labware_id=labware_id, station=station, sub_position=sub_position)
+        """The robot side's ground truth about a plate, and whether it rests in `nest` (if given).
+
+        For success checks and tests only, never for control; raises BridgeError if the answer
+        names a location the labware model does not know."""
+        request = CheckPlacement.Request(labware_id=labware_id)
+        if nest is not None:
+            request.station, request.sub_position = nest.station, nest.sub_position
         response = self._check_placement.call(request, timeout_s)
+        try:
+            location = parse_location(response.location)
+        except ValueError as error:
+            raise BridgeError(f"/check_placement answered an unreadable location: {error}") from error
         return PlacementCheck(
             found=bool(response.found),
             in_nest=bool(response.in_nest),
             position_error_m=float(response.position_error_m),
             yaw_error_rad=float(response.yaw_error_rad),
-            location=response.location,
+            location=location,
             outside=response.outside,
         )
 
@@ -148,8 +155,9 @@ class RobotLink:
         message = self._robot_state.latest
         return None if message is None else robot_status_from_message(message)
 
-    def nest_occupancies(self, timeout_s: float = 5.0) -> tuple[NestOccupancy, ...]:
-        return nest_occupancies_from_message(self._station_states.wait_for_message(timeout_s))
+    def nest_readings(self, timeout_s: float = 5.0) -> tuple[NestReading, ...]:
+        """The latest sensor reading of every nest (waits for the first message up to `timeout_s`)."""
+        return nest_readings_from_message(self._station_states.wait_for_message(timeout_s))
 
     def wait_for_robot_status(
         self, predicate: Callable[[RobotStatus], bool], timeout_s: float = 5.0
@@ -159,13 +167,15 @@ class RobotLink:
         )
         return robot_status_from_message(message)
 
-    def wait_for_nest(self, station: str, sub_position: int, occupied: bool, timeout_s: float = 5.0) -> None:
-        """Wait until the nest sensor of `station`/`sub_position` reports `occupied`."""
+    def wait_for_nest(self, nest: Nest, occupied: bool, timeout_s: float = 5.0) -> None:
+        """Wait until the sensor of `nest` reports `occupied`."""
 
         def matches(message: StationStates) -> bool:
             return any(
-                nest.station == station and nest.sub_position == sub_position and nest.occupied == occupied
-                for nest in message.nests
+                state.station == nest.station
+                and state.sub_position == nest.sub_position
+                and state.occupied == occupied
+                for state in message.nests
             )
 
         self._station_states.wait_for_message(timeout_s, matches)
@@ -181,6 +191,6 @@ class RobotLink:
         message = RobotState(state=RobotState.STATE_ERROR, detail=reason)
         self.runtime.call(lambda: self._robot_state._on_message(message))
 
-    def on_nest_occupancies(self, listener: Callable[[tuple[NestOccupancy, ...]], None]) -> None:
-        """Call `listener(nests)` on every change of /station_states (on the ROS thread)."""
-        self._station_states.add_listener(lambda message: listener(nest_occupancies_from_message(message)))
+    def on_nest_readings(self, listener: Callable[[tuple[NestReading, ...]], None]) -> None:
+        """Call `listener(readings)` on every change of /station_states (on the ROS thread)."""
+        self._station_states.add_listener(lambda message: listener(nest_readings_from_message(message)))

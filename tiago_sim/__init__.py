@@ -10,4 +10,6 @@ Subpackages, lowest first (each imports only those before it):
 - `sequencer`: the task level a real TIAGo++ keeps (GetLabware, PutLabware): a ROS client of the
   robot-level actions that imports nothing of the simulation.
 `transforms` (4x4 rigid transforms) and `node_main` (the shared rclpy main loop) serve them all.
+Below them all lies `labware_model` (a package of its own, shared with the SiLA side): labware
+types, plates, nests and hotel slots are named there.
 """

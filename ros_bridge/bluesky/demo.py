@@ -25,7 +25,8 @@ from bluesky import RunEngine
 from bluesky.utils import ProgressBarManager, RunEngineInterrupted
 from ophyd.sim import SynAxis, SynGauss
 
-from ros_bridge.bluesky.device import LabwareTransferRobot, NestSite
+from labware_model.holders import Nest, location_text
+from ros_bridge.bluesky.device import LabwareTransferRobot
 from ros_bridge.bluesky.plan import sample_exchange_plan
 from ros_bridge.errors import BridgeError
 from ros_bridge.robot_link import RobotLink
@@ -42,33 +43,39 @@ class ExchangeSetup:
     """What the robot side reported: the plate, where it is stored, where it is measured."""
 
     labware_id: str
-    storage: NestSite
-    beam: NestSite
+    storage: Nest
+    beam: Nest
     hotel_slot: int
 
 
 def find_exchange_setup(link: RobotLink) -> ExchangeSetup:
     """The first plate the station sensors report, a free nest on another station, a free hotel slot."""
     workcell = link.describe_workcell()
-    nests = link.nest_occupancies()
-    plate_nest = next((nest for nest in nests if nest.occupied and nest.labware_id), None)
-    if plate_nest is None:
+    readings = link.nest_readings()
+    plate_reading = next((reading for reading in readings if reading.occupied and reading.labware_id), None)
+    if plate_reading is None:
         raise BridgeError("no station reports a plate with a known id")
+    plate_nest = plate_reading.nest
     free_nest = next(
-        (nest for nest in nests if not nest.occupied and nest.station != plate_nest.station), None
+        (
+            reading.nest
+            for reading in readings
+            if not reading.occupied and reading.nest.station != plate_nest.station
+        ),
+        None,
     )
     if free_nest is None:
         stations = ", ".join(station.name for station in workcell.stations)
         raise BridgeError(f"no free nest on a station other than {plate_nest.station} (stations: {stations})")
     robot = link.robot_status()
-    used_slots = {slot.index for slot in robot.hotel if slot.labware_id}
+    used_slots = {reading.slot.index for reading in robot.hotel if reading.labware_id}
     free_slots = [index for index in range(1, workcell.hotel_slots + 1) if index not in used_slots]
     if not free_slots:
         raise BridgeError("every hotel slot on the robot is occupied")
     return ExchangeSetup(
-        labware_id=plate_nest.labware_id,
-        storage=NestSite(plate_nest.station, plate_nest.sub_position),
-        beam=NestSite(free_nest.station, free_nest.sub_position),
+        labware_id=plate_reading.labware_id,
+        storage=plate_nest,
+        beam=free_nest,
         hotel_slot=free_slots[0],
     )
 
@@ -171,14 +178,14 @@ def run_bluesky_demo(
         except RunEngineInterrupted:
             engine.abort("interrupted")
             raise
-        check = link.check_placement(setup.labware_id, setup.storage.station, setup.storage.sub_position)
+        check = link.check_placement(setup.labware_id, setup.storage)
     except Exception as error:  # noqa: BLE001 - the demo reports every failure as exit code 1
         logger.error("bluesky demo failed: %s", _reason(error))
         return 1
     finally:
         runtime.stop()
     if not check.in_nest:
-        logger.error("the plate is not back in %s; it is at %s", setup.storage, check.location)
+        logger.error("the plate is not back in %s; it is at %s", setup.storage, location_text(check.location))
         return 1
     logger.info(
         "plate %s back in %s (%.1f mm off centre) after %.0f s",

@@ -24,12 +24,12 @@ import logging
 import threading
 import time
 from collections.abc import Mapping
-from dataclasses import dataclass
 from typing import Any
 
 from ophyd import Component, Device, Signal, SignalRO
 from ophyd.status import DeviceStatus
 
+from labware_model.holders import HotelSlot, Nest
 from ros_bridge.bluesky.status import ActionStatus
 from ros_bridge.errors import BridgeError
 from ros_bridge.robot_link import LabwareHandover, RobotLink
@@ -45,17 +45,6 @@ class TransferTask(str, enum.Enum):
     PLACE = "place"
     RETURN_PICKUP = "return_pickup"
     RETURN_PLACE = "return_place"
-
-
-@dataclass(frozen=True)
-class NestSite:
-    """One nest of one station: where the labware is stored or measured."""
-
-    station: str
-    sub_position: int = 1
-
-    def __str__(self) -> str:
-        return f"{self.station}/{self.sub_position}"
 
 
 class RobotReading(SignalRO):
@@ -91,8 +80,8 @@ class LabwareTransferRobot(Device):
         self,
         link: RobotLink,
         *,
-        storage: NestSite,
-        beam: NestSite,
+        storage: Nest,
+        beam: Nest,
         labware_id: str,
         labware_type: str = "",
         hotel_slot: int = 1,
@@ -133,7 +122,7 @@ class LabwareTransferRobot(Device):
         label = f"{task.value} {labware_id} {'from' if _is_get(task) else 'to'} {site}"
         send = self.link.get_labware if _is_get(task) else self.link.put_labware
         logger.info("%s: %s (hotel slot %d)", self.name, label, hotel_slot)
-        handover = LabwareHandover(site.station, site.sub_position, hotel_slot, self.labware_type, labware_id)
+        handover = LabwareHandover(site, HotelSlot(hotel_slot), self.labware_type, labware_id)
         goal = send(handover)
         status = ActionStatus(self, goal, label=label, timeout=self.task_timeout_s)
         self.last_task.report(task.value)

@@ -20,8 +20,9 @@ import sys
 from pathlib import Path
 from typing import TextIO
 
+from labware_model.holders import Nest
 from sila_labware.client.errors import LabwareTransferError
-from sila_labware.client.records import Address, Handover
+from sila_labware.client.records import Address
 from sila_labware.client.steps import StepProgress
 from sila_labware.client.transfer_client import LabwareTransferClient
 
@@ -38,17 +39,12 @@ def address(text: str) -> Address:
     return host, int(port)
 
 
-def handover(text: str) -> Handover:
-    """ "station_a/1" -> ("station_a", 1); an argparse type."""
+def handover(text: str) -> Nest:
+    """ "station_a/1" -> Nest("station_a", 1), whose str() is that text again; an argparse type."""
     station, _, sub_position = text.rpartition("/")
     if not station or not sub_position.isdigit() or int(sub_position) < 1:
         raise argparse.ArgumentTypeError(f"{text!r} is not STATION/SUB_POSITION (e.g. station_a/1)")
-    return station, int(sub_position)
-
-
-def handover_text(position: Handover) -> str:
-    """("station_a", 1) -> "station_a/1", the form `handover` reads."""
-    return f"{position[0]}/{position[1]}"
+    return Nest(station, int(sub_position))
 
 
 def add_connection_arguments(parser: argparse.ArgumentParser) -> None:

@@ -8,11 +8,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import NamedTuple
 
+from labware_model.holders import GRIPPER, UNKNOWN, HotelSlot, Location, Nest
+
 Address = tuple[str, int]
 """Where a SiLA server listens: (host, port)."""
 
-Handover = tuple[str, int]
-"""A handover position as the standard has it: (station name, sub-position counted from 1)."""
+Handover = Nest | tuple[str, int]
+"""A handover position: a labware-model `Nest`, or the standard's (station name, sub-position
+counted from 1) as a plain pair."""
 
 
 class HandoverPosition(NamedTuple):
@@ -24,14 +27,32 @@ class HandoverPosition(NamedTuple):
 
 @dataclass(frozen=True)
 class LabwareLocation:
-    """Where the robot's inventory says a plate is: aboard in internal position `index`, or at the
-    handover position `position`, sub-position `index`."""
+    """Where the robot's inventory says a plate is, in the labware model's words: a `Nest`, a
+    `HotelSlot` (the robot's internal position), the gripper, or unknown."""
 
     labware_id: str
     labware_type: str
-    aboard: bool
-    position: str
-    index: int
+    location: Location
+
+    @property
+    def aboard(self) -> bool:
+        return isinstance(self.location, HotelSlot) or self.location == GRIPPER
+
+    @classmethod
+    def from_sila(
+        cls,
+        labware_id: str,
+        labware_type: str,
+        aboard: bool,
+        position: str,
+        index: int,
+        internal_positions: int,
+    ) -> LabwareLocation:
+        """From LabwareInventory's structure: aboard, Index is the internal position (one past the
+        last stands for the gripper); at a station, Position and Index name the nest."""
+        if not aboard:
+            return cls(labware_id, labware_type, Nest(position, index) if position else UNKNOWN)
+        return cls(labware_id, labware_type, GRIPPER if index > internal_positions else HotelSlot(index))
 
 
 @dataclass(frozen=True)

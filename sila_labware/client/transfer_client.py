@@ -33,6 +33,7 @@ from typing import Any, TypeVar
 from sila2.client import SilaClient
 from sila2.framework import SilaConnectionError
 
+from labware_model.holders import Nest
 from sila_labware.client.errors import LabwareTransferError, ParameterRejected, ServerUnreachable, translate
 from sila_labware.client.records import Address, Handover, HandoverPosition, LabwareLocation, OnboardLabware
 from sila_labware.client.sequence import StepPlan, pick_sequence, place_sequence
@@ -199,8 +200,13 @@ class LabwareTransferClient:
         found = self._call(
             "Robot.LocateLabware", lambda: inventory.LocateLabware(LabwareUniqueID=labware_id)
         ).Location
-        return LabwareLocation(
-            found.LabwareUniqueID, found.LabwareType, found.Aboard, found.Position, found.Index
+        return LabwareLocation.from_sila(
+            found.LabwareUniqueID,
+            found.LabwareType,
+            found.Aboard,
+            found.Position,
+            found.Index,
+            self.internal_positions(),
         )
 
     # --- what the robot and stations offer ---
@@ -275,11 +281,13 @@ class LabwareTransferClient:
     def _required_feature(self, name: str) -> Any:
         return self._feature(self._robot, name, (self._robot.address, self._robot.port))
 
-    def _site_of(self, handover: Handover, command: str) -> tuple[Handover, Any]:
+    def _site_of(self, handover: Handover, command: str) -> tuple[tuple[str, int], Any]:
         """The checked handover and its station's site feature; ParameterRejected before anything
         is sent."""
         try:
-            station, sub_position = handover
+            station, sub_position = (
+                (handover.station, handover.sub_position) if isinstance(handover, Nest) else handover
+            )
         except (TypeError, ValueError):
             raise ParameterRejected(
                 f"a handover position is (station, sub-position), not {handover!r}",

@@ -20,8 +20,9 @@ import time
 from dataclasses import asdict, dataclass, field
 from typing import Any, TextIO
 
+from labware_model.holders import Nest, location_text
+from labware_model.readings import PlacementCheck
 from ros_bridge.robot_link import RobotLink
-from ros_bridge.workcell import PlacementCheck
 from sila_labware.client import StepProgress
 from sila_labware.client.console import ProgressLine
 from sila_labware.deployment.clients import transfer_client
@@ -87,16 +88,17 @@ def run_demo(deployment: Deployment, progress_stream: TextIO | None = sys.stderr
         report.error = "the world needs at least two stations"
         return report
     source, destination = stations[0], stations[1]
-    nests = link.nest_occupancies()
-    plate_nest = next((n for n in nests if n.station == source.name and n.occupied), None)
-    free_nest = next((n for n in nests if n.station == destination.name and not n.occupied), None)
-    if plate_nest is None or free_nest is None:
+    nests = link.nest_readings()
+    plate_reading = next((n for n in nests if n.nest.station == source.name and n.occupied), None)
+    free_reading = next((n for n in nests if n.nest.station == destination.name and not n.occupied), None)
+    if plate_reading is None or free_reading is None:
         report.error = f"need a plate on {source.name} and a free nest on {destination.name}"
         return report
-    plate_id = plate_nest.labware_id
+    plate_nest, free_nest = plate_reading.nest, free_reading.nest
+    plate_id = plate_reading.labware_id
     report.labware_id = plate_id
-    report.source = f"{source.name}/{plate_nest.sub_position}"
-    report.destination = f"{destination.name}/{free_nest.sub_position}"
+    report.source = str(plate_nest)
+    report.destination = str(free_nest)
 
     clock = StepClock(link, ProgressLine(progress_stream))
     wall_start, sim_start = time.monotonic(), link.robot_status().stamp_s
@@ -117,13 +119,13 @@ def run_demo(deployment: Deployment, progress_stream: TextIO | None = sys.stderr
     report.steps = clock.steps
     report.wall_seconds = time.monotonic() - wall_start
     report.sim_seconds = link.robot_status().stamp_s - sim_start
-    placement = link.check_placement(plate_id, destination.name, free_nest.sub_position)
+    placement = link.check_placement(plate_id, free_nest)
     report.success = placement.in_nest and not report.error
     if placement.found:
         report.plate_position_error_mm = 1000.0 * placement.position_error_m
         report.plate_yaw_error_deg = math.degrees(placement.yaw_error_rad)
     if not placement.in_nest and not report.error:
-        report.error = misplacement(report.destination, placement)
+        report.error = misplacement(free_nest, placement)
     return report
 
 
@@ -131,11 +133,10 @@ def run_demo(deployment: Deployment, progress_stream: TextIO | None = sys.stderr
 MISPLACED = "physics check: "
 
 
-def misplacement(destination: str, placement: PlacementCheck) -> str:
+def misplacement(destination: Nest, placement: PlacementCheck) -> str:
     """Why the physics check refused a delivery the commands reported as done."""
-    station, _, sub = destination.partition("/")
-    if placement.location != f"station:{station}:{sub}":
-        return f"{MISPLACED}the plate is not in {destination}; it is at {placement.location}"
+    if placement.location != destination:
+        return f"{MISPLACED}the plate is not in {destination}; it is at {location_text(placement.location)}"
     return (
         f"{MISPLACED}the plate rests in {destination} but outside the nest's tolerance: "
         f"{placement.outside or 'limit not reported'} ({1000.0 * placement.position_error_m:.1f} mm "

@@ -20,11 +20,11 @@ from pathlib import Path
 
 from sila2.server import SilaServer
 
+from labware_model.workcell import WorkcellDescription
 from ros_bridge.domain import reserve_domain_id
 from ros_bridge.errors import BridgeError
 from ros_bridge.robot_link import RobotLink
 from ros_bridge.runtime import RosRuntime
-from ros_bridge.workcell import WorkcellDescription
 from sila_labware.deployment.processes import ProcessGroup, ros_environment
 from sila_labware.deployment.supervisor import RobotSideSupervisor
 from sila_labware.device.robot_controller import RobotController

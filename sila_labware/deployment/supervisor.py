@@ -28,10 +28,10 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+from labware_model.holders import UNKNOWN, location_text
 from ros_bridge.errors import BridgeError
 from ros_bridge.robot_link import RobotLink
 from sila_labware.deployment.processes import ProcessGroup
-from sila_labware.device.inventory import UNKNOWN
 from sila_labware.device.robot_controller import RobotController
 
 logger = logging.getLogger(__name__)
@@ -149,9 +149,9 @@ class RobotSideSupervisor:
     def _resynchronise_inventory(self) -> None:
         """Every known plate goes where the new robot side's observations put it, or stays unknown."""
         status = self.link.robot_status()
-        nests = self.link.nest_occupancies()
+        nests = self.link.nest_readings()
         for labware in self.robot.inventory.records():
             location = self.robot.inventory.settle(
                 labware.labware_id, labware.labware_type, None, status, nests
             )
-            logger.info("after restart, %s observed at %s", labware.labware_id, location)
+            logger.info("after restart, %s observed at %s", labware.labware_id, location_text(location))

@@ -10,86 +10,48 @@ Thread-safe (one lock); change listeners run on the thread that made the change.
 
 from __future__ import annotations
 
-import enum
 import logging
 import threading
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
-from ros_bridge.workcell import NestOccupancy, RobotStatus
-from sila_labware.device.validation import Handover
+from labware_model.holders import GRIPPER, UNKNOWN, HotelSlot, Location, Nest, location_text
+from labware_model.readings import NestReading
+from ros_bridge.workcell import RobotStatus
 
 logger = logging.getLogger(__name__)
 
 
-class LocationKind(enum.Enum):
-    STATION = "station"
-    HOTEL = "hotel"
-    GRIPPER = "gripper"
-    UNKNOWN = "unknown"
-
-
-@dataclass(frozen=True)
-class LabwareLocation:
-    """A station nest (station, index = sub-position), a hotel slot (index), the gripper, or unknown."""
-
-    kind: LocationKind
-    station: str = ""
-    index: int = 0
-
-    @property
-    def aboard(self) -> bool:
-        return self.kind in (LocationKind.HOTEL, LocationKind.GRIPPER)
-
-    def __str__(self) -> str:
-        if self.kind is LocationKind.STATION:
-            return f"station:{self.station}:{self.index}"
-        if self.kind is LocationKind.HOTEL:
-            return f"hotel:{self.index}"
-        return self.kind.value
-
-
-UNKNOWN = LabwareLocation(LocationKind.UNKNOWN)
-GRIPPER = LabwareLocation(LocationKind.GRIPPER)
-
-
-def at_station(handover: Handover) -> LabwareLocation:
-    return LabwareLocation(LocationKind.STATION, handover.station, handover.sub_position)
-
-
-def in_hotel(slot: int) -> LabwareLocation:
-    return LabwareLocation(LocationKind.HOTEL, "", slot)
-
-
 @dataclass(frozen=True)
 class LabwareRecord:
+    """A plate the robot handled and where it is: a nest, a hotel slot, the gripper, or `UNKNOWN`."""
+
     labware_id: str
     labware_type: str
-    location: LabwareLocation
+    location: Location
 
 
 def observed_location(
     labware_id: str,
-    handover: Handover | None,
+    handover: Nest | None,
     robot_status: RobotStatus,
-    nests: Iterable[NestOccupancy],
-) -> LabwareLocation:
+    nests: Iterable[NestReading],
+) -> Location:
     """Where the observations put a plate: robot hotel, gripper, a nest reporting it, or the
     hand-over nest if its sensor sees a plate without an id; otherwise unknown."""
-    for slot in robot_status.hotel:
-        if slot.labware_id == labware_id:
-            return in_hotel(slot.index)
+    for reading in robot_status.hotel:
+        if reading.labware_id == labware_id:
+            return reading.slot
     if robot_status.held_labware_id == labware_id:
         return GRIPPER
     nests = tuple(nests)
-    for nest in nests:
-        if nest.occupied and nest.labware_id == labware_id:
-            return LabwareLocation(LocationKind.STATION, nest.station, nest.sub_position)
+    for reading in nests:
+        if reading.occupied and reading.labware_id == labware_id:
+            return reading.nest
     if handover is not None:
-        for nest in nests:
-            if (nest.station, nest.sub_position) == (handover.station, handover.sub_position):
-                if nest.occupied and not nest.labware_id:
-                    return at_station(handover)
+        for reading in nests:
+            if reading.nest == handover and reading.occupied and not reading.labware_id:
+                return handover
     return UNKNOWN
 
 
@@ -114,12 +76,18 @@ class Inventory:
             return tuple(self._records[key] for key in sorted(self._records))
 
     def in_hotel_slot(self, slot: int) -> LabwareRecord | None:
+        """The plate recorded in hotel slot `slot` (1-based), if any."""
         with self._lock:
             return next(
-                (record for record in self._records.values() if record.location == in_hotel(slot)), None
+                (
+                    record
+                    for record in self._records.values()
+                    if isinstance(record.location, HotelSlot) and record.location.index == slot
+                ),
+                None,
             )
 
-    def record(self, labware_id: str, labware_type: str, location: LabwareLocation) -> None:
+    def record(self, labware_id: str, labware_type: str, location: Location) -> None:
         """Put a plate somewhere; keeps a known type when `labware_type` is empty."""
         with self._lock:
             previous = self._records.get(labware_id)
@@ -130,7 +98,7 @@ class Inventory:
             self._records[labware_id] = new_record
             snapshot = tuple(self._records[key] for key in sorted(self._records))
             listeners = list(self._listeners)
-        logger.info("labware %s is now at %s", labware_id, location)
+        logger.info("labware %s is now at %s", labware_id, location_text(location))
         for listener in listeners:
             listener(snapshot)
 
@@ -138,10 +106,10 @@ class Inventory:
         self,
         labware_id: str,
         labware_type: str,
-        handover: Handover | None,
+        handover: Nest | None,
         robot_status: RobotStatus,
-        nests: Iterable[NestOccupancy],
-    ) -> LabwareLocation:
+        nests: Iterable[NestReading],
+    ) -> Location:
         """Record where the observations put the plate (after a transfer, whatever its outcome)."""
         location = observed_location(labware_id, handover, robot_status, nests)
         self.record(labware_id, labware_type, location)
@@ -149,8 +117,8 @@ class Inventory:
 
     def observe_robot(self, robot_status: RobotStatus) -> None:
         """Take in plates the robot reports aboard (hotel slots, gripper) under their ids."""
-        for slot in robot_status.hotel:
-            if slot.labware_id:
-                self.record(slot.labware_id, slot.labware_type, in_hotel(slot.index))
+        for reading in robot_status.hotel:
+            if reading.labware_id:
+                self.record(reading.labware_id, reading.labware_type, reading.slot)
         if robot_status.held_labware_id:
             self.record(robot_status.held_labware_id, "", GRIPPER)

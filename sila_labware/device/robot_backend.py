@@ -25,9 +25,11 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Protocol, runtime_checkable
 
+from labware_model.holders import Nest
+from labware_model.readings import NestReading
 from ros_bridge.goal_status import ActionGoal
 from ros_bridge.progress import GoalProgress
-from ros_bridge.workcell import LabwareHandover, NestOccupancy, RobotStatus
+from ros_bridge.workcell import LabwareHandover, RobotStatus
 
 FeedbackListener = Callable[[GoalProgress], None]
 
@@ -36,14 +38,14 @@ FeedbackListener = Callable[[GoalProgress], None]
 class StationBackend(Protocol):
     """The stations' nest sensors, as a station's digital twin reads them."""
 
-    def nest_occupancies(self, timeout_s: float = 5.0) -> tuple[NestOccupancy, ...]:
+    def nest_readings(self, timeout_s: float = 5.0) -> tuple[NestReading, ...]:
         """The latest reading of every nest sensor of every station (waits up to `timeout_s` s
         for a first reading; raises BridgeTimeout if none came)."""
         ...
 
-    def wait_for_nest(self, station: str, sub_position: int, occupied: bool, timeout_s: float = 5.0) -> None:
-        """Return once the sensor of nest `station`/`sub_position` reports `occupied` (at once if
-        it already does); raise BridgeTimeout after `timeout_s` s."""
+    def wait_for_nest(self, nest: Nest, occupied: bool, timeout_s: float = 5.0) -> None:
+        """Return once the sensor of `nest` reports `occupied` (at once if it already does); raise
+        BridgeTimeout after `timeout_s` s."""
         ...
 
 

@@ -27,16 +27,17 @@ import threading
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from labware_model.holders import HotelSlot, Nest, location_text
+from labware_model.workcell import WorkcellDescription
 from ros_bridge.errors import BridgeError, BridgeTimeout
 from ros_bridge.goal_status import ActionGoal, ActionOutcome
 from ros_bridge.progress import CommandProgress, ProgressReport
-from ros_bridge.workcell import LabwareHandover, RobotStatus, WorkcellDescription
+from ros_bridge.workcell import LabwareHandover, RobotStatus
 from sila_labware.device.errors import CommandSequenceError, MotionFailed, TransferFailed
-from sila_labware.device.inventory import Inventory, in_hotel
+from sila_labware.device.inventory import Inventory
 from sila_labware.device.robot_backend import RobotBackend
 from sila_labware.device.sequences import ManipulatorSequence, PreparedTransfer
 from sila_labware.device.validation import (
-    Handover,
     check_handover,
     check_intermediate_actions,
     check_internal_position,
@@ -177,9 +178,8 @@ class RobotController:
         transfer = self.sequence.begin_get(handover) if getting else self.sequence.begin_put(handover)
         try:
             request = LabwareHandover(
-                handover.station,
-                handover.sub_position,
-                transfer.internal_position,
+                handover,
+                HotelSlot(transfer.internal_position),
                 transfer.labware_type,
                 transfer.labware_id,
                 intermediate_actions,
@@ -261,7 +261,7 @@ class RobotController:
         except BridgeTimeout:
             logger.warning("the motion succeeded but the robot state does not report %s yet", what)
 
-    def _drive_for_transfer(self, handover: Handover, progress: CommandProgress) -> None:
+    def _drive_for_transfer(self, handover: Nest, progress: CommandProgress) -> None:
         """Undock if needed, then drive to the station's POI (unless already there)."""
         success = False
         try:
@@ -325,7 +325,7 @@ class RobotController:
         if not labware_id:
             logger.warning("transfer at %s without a labware id: inventory not updated", transfer.handover)
             return
-        expected_slot = in_hotel(transfer.internal_position)
+        expected_slot = HotelSlot(transfer.internal_position)
 
         def shows_outcome(status: RobotStatus) -> bool:
             aboard = labware_id in status.onboard_labware_ids
@@ -339,35 +339,35 @@ class RobotController:
             # /station_states comes at 2 Hz, /robot_state on change: without this wait a plate that
             # was placed could be read as in neither place, and recorded as lost (seen in the soak).
             try:
-                self.link.wait_for_nest(
-                    transfer.handover.station, transfer.handover.sub_position, True, self.waits.settle_s
-                )
+                self.link.wait_for_nest(transfer.handover, True, self.waits.settle_s)
             except BridgeTimeout:
                 logger.warning("PutLabware succeeded but the sensor of %s sees no plate", transfer.handover)
         location = self.inventory.settle(
-            labware_id, transfer.labware_type, transfer.handover, status, self.link.nest_occupancies()
+            labware_id, transfer.labware_type, transfer.handover, status, self.link.nest_readings()
         )
         if outcome.success and expect_aboard and location != expected_slot:
             logger.warning(
-                "GetLabware succeeded but %s is at %s, not %s", labware_id, location, expected_slot
+                "GetLabware succeeded but %s is at %s, not %s",
+                labware_id,
+                location_text(location),
+                location_text(expected_slot),
             )
 
-    def _refuse_occupied_destination(self, handover: Handover) -> None:
+    def _refuse_occupied_destination(self, handover: Nest) -> None:
         """Before any motion: a nest whose sensor sees a plate cannot take another one."""
-        for nest in self.link.nest_occupancies():
-            here = (nest.station, nest.sub_position) == (handover.station, handover.sub_position)
-            if here and nest.occupied:
-                holder = f" (holds {nest.labware_id})" if nest.labware_id else ""
+        for reading in self.link.nest_readings():
+            if reading.nest == handover and reading.occupied:
+                holder = f" (holds {reading.labware_id})" if reading.labware_id else ""
                 raise CommandSequenceError(
-                    f"PrepareForOutput refused: destination {handover.station}/{handover.sub_position} "
-                    f"is occupied{holder}; the robot did not move"
+                    f"PrepareForOutput refused: destination {handover} is occupied{holder}; "
+                    "the robot did not move"
                 )
 
     @staticmethod
     def _hotel_occupant(status: RobotStatus, slot: int) -> str | None:
-        for content in status.hotel:
-            if content.index == slot and content.labware_id:
-                return content.labware_id
+        for reading in status.hotel:
+            if reading.slot.index == slot and reading.labware_id:
+                return reading.labware_id
         return None
 
 

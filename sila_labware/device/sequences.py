@@ -23,8 +23,8 @@ import enum
 import threading
 from dataclasses import dataclass
 
+from labware_model.holders import Nest
 from sila_labware.device.errors import CommandSequenceError
-from sila_labware.device.validation import Handover
 
 
 class ManipulatorPhase(enum.Enum):
@@ -40,9 +40,9 @@ class ManipulatorPhase(enum.Enum):
 
 @dataclass(frozen=True)
 class PreparedTransfer:
-    """What a Prepare command announced: where, which hotel slot, which plate."""
+    """What a Prepare command announced: the hand-over nest, which hotel slot, which plate."""
 
-    handover: Handover
+    handover: Nest
     internal_position: int
     labware_type: str = ""
     labware_id: str = ""
@@ -93,13 +93,13 @@ class ManipulatorSequence:
             else:
                 raise RuntimeError(f"finish_prepare while {self._phase.value}")
 
-    def begin_get(self, handover: Handover) -> PreparedTransfer:
+    def begin_get(self, handover: Nest) -> PreparedTransfer:
         """GetLabware is allowed only right after PrepareForInput at the same hand-over position."""
         return self._begin_transfer(
             handover, ManipulatorPhase.PREPARED_FOR_INPUT, ManipulatorPhase.GETTING, "GetLabware"
         )
 
-    def begin_put(self, handover: Handover) -> PreparedTransfer:
+    def begin_put(self, handover: Nest) -> PreparedTransfer:
         """PutLabware is allowed only right after PrepareForOutput at the same hand-over position."""
         return self._begin_transfer(
             handover, ManipulatorPhase.PREPARED_FOR_OUTPUT, ManipulatorPhase.PUTTING, "PutLabware"
@@ -144,7 +144,7 @@ class ManipulatorSequence:
             self._phase, self._transfer = busy, transfer
 
     def _begin_transfer(
-        self, handover: Handover, required: ManipulatorPhase, busy: ManipulatorPhase, command: str
+        self, handover: Nest, required: ManipulatorPhase, busy: ManipulatorPhase, command: str
     ) -> PreparedTransfer:
         with self._lock:
             self._refuse_if_busy(command)
@@ -201,7 +201,7 @@ class SiteSequence:
             self._refuse_unless_idle(sub_position, "PrepareForInput")
             if occupied:
                 raise CommandSequenceError(
-                    f"PrepareForInput refused: nest {self.station}/{sub_position} is occupied; "
+                    f"PrepareForInput refused: nest {Nest(self.station, sub_position)} is occupied; "
                     "the plate there must be removed first"
                 )
             self._nests[sub_position] = NestExpectation(
@@ -214,7 +214,7 @@ class SiteSequence:
             self._refuse_unless_idle(sub_position, "PrepareForOutput")
             if not occupied:
                 raise CommandSequenceError(
-                    f"PrepareForOutput refused: nest {self.station}/{sub_position} is empty; "
+                    f"PrepareForOutput refused: nest {Nest(self.station, sub_position)} is empty; "
                     "nothing to hand over"
                 )
             self._nests[sub_position] = NestExpectation(NestPhase.PREPARED_FOR_OUTPUT, internal_position)
@@ -236,7 +236,7 @@ class SiteSequence:
         if current is not NestPhase.IDLE:
             follow_up = "LabwareDelivered" if current is NestPhase.PREPARED_FOR_INPUT else "LabwareRemoved"
             raise CommandSequenceError(
-                f"{command} refused: nest {self.station}/{sub_position} is already {current.value}; "
+                f"{command} refused: nest {Nest(self.station, sub_position)} is already {current.value}; "
                 f"{follow_up} must come first"
             )
 
@@ -247,7 +247,7 @@ class SiteSequence:
             expectation = self._nests[sub_position]
             if expectation.phase is not required:
                 raise CommandSequenceError(
-                    f"{command} at {self.station}/{sub_position} needs {prepare} first; "
+                    f"{command} at {Nest(self.station, sub_position)} needs {prepare} first; "
                     f"the nest is {expectation.phase.value}"
                 )
             self._nests[sub_position] = NestExpectation(NestPhase.IDLE)

@@ -23,8 +23,10 @@ from __future__ import annotations
 
 import logging
 
+from labware_model.holders import Nest
+from labware_model.readings import NestReading
+from labware_model.workcell import StationDescription
 from ros_bridge.errors import BridgeTimeout
-from ros_bridge.workcell import NestOccupancy, StationDescription
 from sila_labware.device.errors import CommandSequenceError
 from sila_labware.device.robot_backend import StationBackend
 from sila_labware.device.sequences import NestExpectation, NestPhase, SiteSequence
@@ -60,13 +62,14 @@ class StationController:
         check_internal_position(internal_position, self.internal_positions)
         check_text(labware_type, "LabwareType", allow_empty=True)
         check_text(labware_id, "LabwareUniqueID", allow_empty=True)
-        occupied = self.nest(sub_position).occupied
+        occupied = self.nest_reading(sub_position).occupied
         self.sequence.prepare_for_input(sub_position, internal_position, labware_type, labware_id, occupied)
 
     def prepare_for_output(self, position: str, sub_position: int, internal_position: int) -> None:
         sub_position = self._check_handover(position, sub_position)
         check_internal_position(internal_position, self.internal_positions)
-        self.sequence.prepare_for_output(sub_position, internal_position, self.nest(sub_position).occupied)
+        occupied = self.nest_reading(sub_position).occupied
+        self.sequence.prepare_for_output(sub_position, internal_position, occupied)
 
     def labware_delivered(self, position: str, sub_position: int) -> NestExpectation:
         sub_position = self._check_handover(position, sub_position)
@@ -78,13 +81,14 @@ class StationController:
         self._require_phase_then_sensor(sub_position, "LabwareRemoved", want_occupied=False)
         return self.sequence.labware_removed(sub_position)
 
-    def nest(self, sub_position: int) -> NestOccupancy:
+    def nest_reading(self, sub_position: int) -> NestReading:
         """The sensor reading of one nest (a nest missing from the report counts as empty)."""
-        for nest in self.link.nest_occupancies():
-            if nest.station == self.station.name and nest.sub_position == sub_position:
-                return nest
-        logger.warning("no sensor reading for %s/%d; treating it as empty", self.station.name, sub_position)
-        return NestOccupancy(self.station.name, sub_position, False, "")
+        nest = Nest(self.station.name, sub_position)
+        for reading in self.link.nest_readings():
+            if reading.nest == nest:
+                return reading
+        logger.warning("no sensor reading for %s; treating it as empty", nest)
+        return NestReading(nest, False, "")
 
     def _check_handover(self, position: str, sub_position: int) -> int:
         return check_handover(
@@ -99,11 +103,11 @@ class StationController:
                 self.sequence.labware_delivered(sub_position)  # raises the ordering error
             else:
                 self.sequence.labware_removed(sub_position)
+        nest = Nest(self.station.name, sub_position)
         try:
-            self.link.wait_for_nest(self.station.name, sub_position, want_occupied, self.settle_timeout_s)
+            self.link.wait_for_nest(nest, want_occupied, self.settle_timeout_s)
         except BridgeTimeout as error:
             state = "still sees no plate" if want_occupied else "still sees a plate"
             raise CommandSequenceError(
-                f"{command} refused: the sensor of nest {self.station.name}/{sub_position} {state} "
-                f"after {self.settle_timeout_s:.0f} s"
+                f"{command} refused: the sensor of nest {nest} {state} after {self.settle_timeout_s:.0f} s"
             ) from error

@@ -11,22 +11,11 @@ them empty (the robot then tracks the plate under the id the robot side reports)
 from __future__ import annotations
 
 from collections.abc import Collection, Mapping, Sequence
-from dataclasses import dataclass
 
+from labware_model.holders import Nest
 from sila_labware.device.errors import ParameterError
 
 MAX_TEXT_LENGTH = 255
-
-
-@dataclass(frozen=True)
-class Handover:
-    """A hand-over position of the standard: a station name and a 1-based nest index."""
-
-    station: str
-    sub_position: int
-
-    def __str__(self) -> str:
-        return f"{self.station}/{self.sub_position}"
 
 
 def check_text(value: str, parameter: str, *, allow_empty: bool) -> str:
@@ -47,8 +36,8 @@ def check_handover(
     sub_position: int,
     sub_positions_by_station: Mapping[str, int],
     parameter: str = "HandoverPosition",
-) -> Handover:
-    """The named station must exist and have at least `sub_position` nests."""
+) -> Nest:
+    """The named station must exist and have at least `sub_position` nests; returns that nest."""
     check_text(position, parameter, allow_empty=False)
     if position not in sub_positions_by_station:
         known = ", ".join(sorted(sub_positions_by_station)) or "none"
@@ -60,7 +49,7 @@ def check_handover(
             f"SubPosition {sub_position} is beyond handover position {position!r}, "
             f"which has {count} sub-position{'s' if count != 1 else ''} (1..{count})",
         )
-    return Handover(position, sub_position)
+    return Nest(position, sub_position)
 
 
 def check_internal_position(index: int, count: int, parameter: str = "InternalPosition") -> int:

@@ -19,9 +19,9 @@ from pathlib import Path
 
 from sila2.server import SilaServer
 
+from labware_model.workcell import WorkcellDescription
 from ros_bridge.robot_link import RobotLink
 from ros_bridge.runtime import RosRuntime
-from ros_bridge.workcell import WorkcellDescription
 from sila_labware.servers.refusal_log import install_refusal_log_filter
 from sila_labware.servers.serving import start_sila_server
 from sila_labware.servers.tls import CertificateAuthority

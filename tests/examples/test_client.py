@@ -15,6 +15,7 @@ import pytest
 from sila2.client import SilaClient
 from sila2.framework import DefinedExecutionError
 
+from labware_model.holders import Nest
 from sila_labware.client import (
     DefinedError,
     InvalidCommandSequence,
@@ -155,9 +156,9 @@ def test_a_transfer_reports_every_step_with_progress_that_never_goes_down(
     assert any(0.0 < record.progress < 1.0 and record.remaining_s is not None for record in get_labware)
 
     assert stack.link is not None
-    assert stack.link.check_placement(PLATE, "station_b", 1).in_nest
+    assert stack.link.check_placement(PLATE, Nest("station_b", 1)).in_nest
     location = client.locate(PLATE)
-    assert (location.aboard, location.position, location.index) == (False, "station_b", 1)
+    assert (location.aboard, location.location) == (False, Nest("station_b", 1))
     assert client.onboard_labware() == []
 
 

@@ -18,6 +18,7 @@ from types import ModuleType
 import pytest
 import yaml
 
+from labware_model.holders import Nest
 from sila_labware.client.sequence import PICK_STEPS, PLACE_STEPS, TRANSFER_STEPS
 from sila_labware.deployment.stack import Deployment
 from tests.helpers.sila_stack import DEFAULT_WORLD, REPOSITORY, start_stack
@@ -65,7 +66,7 @@ def connection_arguments(stack: Deployment) -> list[str]:
 
 def assert_in_nest(stack: Deployment, plate: str, station: str, sub_position: int) -> None:
     assert stack.link is not None
-    placement = stack.link.check_placement(plate, station, sub_position)
+    placement = stack.link.check_placement(plate, Nest(station, sub_position))
     assert placement.in_nest, f"{plate} is not in {station}/{sub_position}: it is at {placement.location}"
 
 

@@ -23,10 +23,12 @@ from dataclasses import dataclass, field, replace
 from types import SimpleNamespace
 from typing import Any
 
+from labware_model.holders import HotelSlot, Nest
+from labware_model.readings import HotelSlotReading, NestReading
 from ros_bridge.errors import BridgeError, BridgeTimeout
 from ros_bridge.goal_status import ActionGoal, ActionOutcome
 from ros_bridge.progress import GoalProgress
-from ros_bridge.workcell import HotelSlotContent, LabwareHandover, NestOccupancy, RobotStatus
+from ros_bridge.workcell import LabwareHandover, RobotStatus
 
 FeedbackListener = Callable[[GoalProgress], None]
 
@@ -52,7 +54,7 @@ class ScriptedGoal:
     """Called on the sending thread after the feedback and before the end (a second command)."""
     robot_after: RobotStatus | None = None
     """The robot state once the goal ends, instead of its natural effect (success) or no change."""
-    nests_after: tuple[NestOccupancy, ...] | None = None
+    nests_after: tuple[NestReading, ...] | None = None
     result: Any = None
 
 
@@ -84,13 +86,15 @@ def robot_state(
     state: str = "idle", poi: str = "", hotel: dict[int, str] | None = None, held: str = ""
 ) -> RobotStatus:
     """A robot state with hotel slot -> plate id (empty string: free); two free slots by default."""
-    slots = tuple(HotelSlotContent(index, plate, "") for index, plate in (hotel or {1: "", 2: ""}).items())
+    slots = tuple(
+        HotelSlotReading(HotelSlot(index), plate, "") for index, plate in (hotel or {1: "", 2: ""}).items()
+    )
     return RobotStatus(state, "", poi, 0.0, 0.0, 0.0, slots, held)
 
 
-def nest(station: str, sub_position: int, plate: str = "", occupied: bool | None = None) -> NestOccupancy:
+def nest(station: str, sub_position: int, plate: str = "", occupied: bool | None = None) -> NestReading:
     """A nest reading; occupied when it holds a plate unless `occupied` says otherwise."""
-    return NestOccupancy(station, sub_position, bool(plate) if occupied is None else occupied, plate)
+    return NestReading(Nest(station, sub_position), bool(plate) if occupied is None else occupied, plate)
 
 
 @dataclass
@@ -106,7 +110,7 @@ class SentGoal:
 class FakeRobot:
     """Satisfies `sila_labware.device.robot_backend.RobotBackend` in memory."""
 
-    def __init__(self, robot: RobotStatus | None = None, nests: tuple[NestOccupancy, ...] = ()) -> None:
+    def __init__(self, robot: RobotStatus | None = None, nests: tuple[NestReading, ...] = ()) -> None:
         self._changed = threading.Condition()
         self._robot = robot or robot_state()
         self._nests = tuple(nests)
@@ -128,7 +132,7 @@ class FakeRobot:
         for listener in listeners:
             listener(robot)
 
-    def set_nests(self, nests: tuple[NestOccupancy, ...]) -> None:
+    def set_nests(self, nests: tuple[NestReading, ...]) -> None:
         with self._changed:
             self._nests = tuple(nests)
             self._changed.notify_all()
@@ -154,16 +158,13 @@ class FakeRobot:
         with self._changed:
             self._listeners.append(listener)
 
-    def nest_occupancies(self, timeout_s: float = 5.0) -> tuple[NestOccupancy, ...]:
+    def nest_readings(self, timeout_s: float = 5.0) -> tuple[NestReading, ...]:
         with self._changed:
             return self._nests
 
-    def wait_for_nest(self, station: str, sub_position: int, occupied: bool, timeout_s: float = 5.0) -> None:
+    def wait_for_nest(self, nest: Nest, occupied: bool, timeout_s: float = 5.0) -> None:
         def shows() -> bool:
-            return any(
-                (reading.station, reading.sub_position, reading.occupied) == (station, sub_position, occupied)
-                for reading in self._nests
-            )
+            return any((reading.nest, reading.occupied) == (nest, occupied) for reading in self._nests)
 
         with self._changed:
             if not self._changed.wait_for(shows, timeout_s):
@@ -234,7 +235,7 @@ class FakeRobot:
         )
         return True
 
-    def _apply(self, robot: RobotStatus | None, nests: tuple[NestOccupancy, ...] | None) -> None:
+    def _apply(self, robot: RobotStatus | None, nests: tuple[NestReading, ...] | None) -> None:
         if nests is not None:
             self.set_nests(nests)
         if robot is not None:
@@ -255,23 +256,23 @@ class FakeRobot:
         slot_plate = plate if getting else ""
         hotel = tuple(
             replace(slot, labware_id=slot_plate, labware_type=handover.labware_type if getting else "")
-            if slot.index == handover.hotel_slot
+            if slot.slot == handover.hotel_slot
             else slot
             for slot in robot.hotel
         )
         self.set_nests(
             tuple(
-                nest(reading.station, reading.sub_position, "" if getting else plate)
-                if (reading.station, reading.sub_position) == (handover.station, handover.sub_position)
+                NestReading(reading.nest, not getting, "" if getting else plate)
+                if reading.nest == handover.nest
                 else reading
-                for reading in self.nest_occupancies()
+                for reading in self.nest_readings()
             )
         )
         return replace(robot, hotel=hotel)
 
     def _plate_in_nest(self, handover: LabwareHandover) -> str:
-        for reading in self.nest_occupancies():
-            if (reading.station, reading.sub_position) == (handover.station, handover.sub_position):
+        for reading in self.nest_readings():
+            if reading.nest == handover.nest:
                 return reading.labware_id
         return ""
 

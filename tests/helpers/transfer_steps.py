@@ -108,4 +108,7 @@ class Cell:
 
     def nest_occupied(self) -> dict[tuple[str, int], bool]:
         assert self.deployment.link is not None
-        return {(n.station, n.sub_position): n.occupied for n in self.deployment.link.nest_occupancies()}
+        return {
+            (reading.nest.station, reading.nest.sub_position): reading.occupied
+            for reading in self.deployment.link.nest_readings()
+        }

@@ -19,7 +19,8 @@ from bluesky import RunEngine
 from bluesky.utils import FailedStatus, RunEngineInterrupted
 from ophyd.sim import SynAxis, SynGauss
 
-from ros_bridge.bluesky import ActionFailed, LabwareTransferRobot, NestSite, sample_exchange_plan
+from labware_model.holders import Nest
+from ros_bridge.bluesky import ActionFailed, LabwareTransferRobot, sample_exchange_plan
 from ros_bridge.bluesky.demo import MEASURE_POSITION_M, find_exchange_setup, run_bluesky_demo
 from ros_bridge.robot_link import RobotLink
 from ros_bridge.runtime import RosRuntime
@@ -28,8 +29,8 @@ from tests.helpers.sim_parameters import set_node_parameter
 
 DEFAULT_WORLD = Path(__file__).resolve().parents[2] / "tiago_sim" / "worlds" / "default.yaml"
 PLATE = "plate_001"
-STORAGE = NestSite("station_a", 1)
-BEAM = NestSite("station_b", 1)
+STORAGE = Nest("station_a", 1)
+BEAM = Nest("station_b", 1)
 MEASURE_M, LOAD_M = 0.26, 0.0
 MOVING_STATES = ("navigating", "manipulating")
 
@@ -68,7 +69,7 @@ class Documents:
         return [event for event in self.of("event") if event["descriptor"] in descriptors]
 
 
-def make_robot(link: RobotLink, storage: NestSite = STORAGE, beam: NestSite = BEAM) -> LabwareTransferRobot:
+def make_robot(link: RobotLink, storage: Nest = STORAGE, beam: Nest = BEAM) -> LabwareTransferRobot:
     return LabwareTransferRobot(
         link, storage=storage, beam=beam, labware_id=PLATE, hotel_slot=1, task_timeout_s=300.0
     )
@@ -87,8 +88,8 @@ def exchange(robot: LabwareTransferRobot) -> Any:
     return sample_exchange_plan(robot, stage, detector, measure_position=MEASURE_M, load_position=LOAD_M)
 
 
-def assert_plate_in(link: RobotLink, site: NestSite) -> None:
-    check = link.check_placement(PLATE, site.station, site.sub_position)
+def assert_plate_in(link: RobotLink, site: Nest) -> None:
+    check = link.check_placement(PLATE, site)
     assert check.in_nest, f"plate not in {site}: {check}"
 
 
@@ -104,7 +105,7 @@ def test_the_workcell_offers_the_exchange_the_tests_assume(link: RobotLink) -> N
 def test_unknown_station_fails_the_plan_with_the_robots_reason(link: RobotLink) -> None:
     engine, documents = make_engine()
     with pytest.raises(FailedStatus) as failure:
-        engine(exchange(make_robot(link, storage=NestSite("mars", 1))))
+        engine(exchange(make_robot(link, storage=Nest("mars", 1))))
     cause = failure.value.__cause__
     assert isinstance(cause, ActionFailed) and cause.error_code == "UNKNOWN_STATION", cause
     assert "mars" in cause.message

@@ -23,8 +23,9 @@ from labware_interfaces.action import NavigateToPoi
 from ophyd import Device
 from ophyd.utils import StatusTimeoutError
 
+from labware_model.holders import Nest
 from ros_bridge.actions import ActionCaller
-from ros_bridge.bluesky import ActionFailed, ActionStatus, LabwareTransferRobot, NestSite
+from ros_bridge.bluesky import ActionFailed, ActionStatus, LabwareTransferRobot
 from ros_bridge.bluesky.demo import run_bluesky_demo
 from ros_bridge.robot_link import RobotLink
 from ros_bridge.runtime import RosRuntime
@@ -133,8 +134,8 @@ def test_robot_device_reads_robot_state_and_refuses_unknown_tasks(runtime: RosRu
     link = RobotLink(runtime)
     robot = LabwareTransferRobot(
         link,
-        storage=NestSite("rack", 2),
-        beam=NestSite("reader", 1),
+        storage=Nest("rack", 2),
+        beam=Nest("reader", 1),
         labware_id="plate_7",
         name="robot",
     )

@@ -2,7 +2,10 @@
 
 Why: nothing else hard-codes a station, a POI or a marker id; moving a station is a YAML edit.
 The schema is documented in README.md, "The world file". Everything here is frozen and pure (no
-PyBullet), so any thread may read a World.
+PyBullet), so any thread may read a World. What the world holds is named in the labware model
+(`labware_model`): its labware types are `LabwareType`s, a station's nests are `Nest`s, and its
+plates are `Plate`s, each in a `Nest` or a `HotelSlot`; this module adds the geometry (poses and
+sizes of tables, markers and nest sites).
 
 Frames: ``table`` frame on the table top centre (x away from the robot's working side, z up);
 ``marker`` frame as OpenCV ArUco (x right, y up, z out of the face); ``site`` frame of a nest on
@@ -20,6 +23,9 @@ from typing import Any
 import numpy as np
 import yaml
 
+from labware_model.holders import HotelSlot, Nest
+from labware_model.labware import LabwareType, Plate
+from labware_model.workcell import StationDescription, WorkcellDescription
 from tiago_sim import transforms as tf
 
 DEFAULT_WORLD = Path(__file__).resolve().parents[1] / "worlds" / "default.yaml"
@@ -44,15 +50,6 @@ class Pose2D:
 
 
 @dataclass(frozen=True)
-class LabwareType:
-    name: str
-    length: float  # m, long side
-    width: float  # m, short side
-    height: float
-    mass: float  # kg
-
-
-@dataclass(frozen=True)
 class Station:
     """A table with an ArUco marker and a row of nests (sub-positions 1..n)."""
 
@@ -73,6 +70,10 @@ class Station:
     lateral: float  # and this far to the side, so the site lies on the working arm's side
     approach_height: float  # site_approach is this far above the site
     work_standoff: float = 0.0  # the marker-guided final approach ends this close (0: same as standoff)
+
+    def nests(self) -> tuple[Nest, ...]:
+        """Its nests, sub-position 1 first."""
+        return tuple(Nest(self.name, sub_position) for sub_position in range(1, self.sub_positions + 1))
 
     def T_world_table(self) -> np.ndarray:
         return self.table_pose.matrix(self.table_size[2])
@@ -120,15 +121,6 @@ class Station:
 
 
 @dataclass(frozen=True)
-class InitialPlate:
-    labware_id: str
-    labware_type: str
-    station: str = ""  # either station + sub_position ...
-    sub_position: int = 0
-    hotel_slot: int = 0  # ... or a hotel slot (1-based)
-
-
-@dataclass(frozen=True)
 class World:
     source: str
     dock_pose: Pose2D  # base_footprint pose when docked (facing away from the dock)
@@ -136,7 +128,7 @@ class World:
     pois: Mapping[str, Pose2D]
     stations: tuple[Station, ...]
     labware_types: Mapping[str, LabwareType]
-    plates: tuple[InitialPlate, ...]
+    plates: Mapping[Plate, Nest | HotelSlot]  # where each plate starts, in the file's order
     start_docked: bool
     hotel_slots: int = 2
     floor_size: float = 12.0
@@ -147,6 +139,15 @@ class World:
             if station.name == name:
                 return station
         raise KeyError(f"unknown station {name!r}")
+
+    def describe_workcell(self) -> WorkcellDescription:
+        """What the robot serves in this world (the answer of /describe_workcell)."""
+        return WorkcellDescription(
+            stations=tuple(StationDescription(s.name, s.sub_positions, s.poi) for s in self.stations),
+            hotel_slots=self.hotel_slots,
+            pois=tuple(sorted(self.pois)),
+            dock_poi=self.dock_poi,
+        )
 
 
 class _Reader:
@@ -327,9 +328,10 @@ def load_world(path: str | Path = DEFAULT_WORLD) -> World:
     )
 
 
-def _read_plates(r: _Reader, data: dict, stations: dict[str, Station], types: dict, hotel_slots: int):
-    plates = []
-    used: set[tuple] = set()
+def _read_plates(
+    r: _Reader, data: dict, stations: dict[str, Station], types: dict, hotel_slots: int
+) -> dict[Plate, Nest | HotelSlot]:
+    plates: dict[Plate, Nest | HotelSlot] = {}
     raw_plates = r.get(data, "plates", "", [])
     if not isinstance(raw_plates, list):
         raise r.fail("plates", "expected a list")
@@ -339,20 +341,23 @@ def _read_plates(r: _Reader, data: dict, stations: dict[str, Station], types: di
         labware_type = r.text(item, "type", where)
         if labware_type not in types:
             raise r.fail(f"{where}.type", f"unknown labware type {labware_type!r}")
+        holder: Nest | HotelSlot
         if "hotel_slot" in item:
-            place: tuple = ("hotel", r.integer(item, "hotel_slot", where, 1, hotel_slots))
-            plate = InitialPlate(r.text(item, "id", where), labware_type, hotel_slot=place[1])
+            holder = HotelSlot(r.integer(item, "hotel_slot", where, 1, hotel_slots))
         else:
             station = r.text(item, "station", where)
             if station not in stations:
                 raise r.fail(f"{where}.station", f"unknown station {station!r}")
-            sub = r.integer(item, "sub_position", where, 1, stations[station].sub_positions)
-            place = (station, sub)
-            plate = InitialPlate(r.text(item, "id", where), labware_type, station, sub)
-        if place in used:
-            raise r.fail(where, f"{place} already holds a plate")
+            holder = Nest(station, r.integer(item, "sub_position", where, 1, stations[station].sub_positions))
+        plate = Plate(r.text(item, "id", where), labware_type)
+        if holder in plates.values():
+            raise r.fail(where, f"{_place_of(holder)} already holds a plate")
         if any(known.labware_id == plate.labware_id for known in plates):
             raise r.fail(f"{where}.id", f"duplicate plate id {plate.labware_id!r}")
-        used.add(place)
-        plates.append(plate)
-    return tuple(plates)
+        plates[plate] = holder
+    return plates
+
+
+def _place_of(holder: Nest | HotelSlot) -> tuple:
+    """The holder as the world file's messages have always shown it: ('hotel', 2), ('station_a', 1)."""
+    return ("hotel", holder.index) if isinstance(holder, HotelSlot) else (holder.station, holder.sub_position)

@@ -85,11 +85,14 @@ def main(argv: list[str] | None = None) -> int:
     from rclpy.qos import QoSProfile, ReliabilityPolicy
     from rosgraph_msgs.msg import Clock
 
+    from labware_model.holders import Nest
     from tiago_sim import transforms as tf
     from tiago_sim.lab.world import DEFAULT_WORLD, load_world
 
     world = load_world(args.world or DEFAULT_WORLD)
-    plate = next(p for p in world.plates if p.station == args.source)
+    plate = next(
+        p for p, holder in world.plates.items() if isinstance(holder, Nest) and holder.station == args.source
+    )
     world_args = ["--world", str(args.world or DEFAULT_WORLD)]
     log_dir = Path(tempfile.mkdtemp(prefix="tiago_benchmark_"))
     sim = _start(

@@ -156,7 +156,7 @@ def draw(world: World, seed: int, levels: DisturbanceLevels) -> TrialDisturbance
         marker[s.name] = _offset(rng, levels.marker_xy_m, levels.marker_yaw_rad)
         nest[s.name] = _offset(rng, levels.nest_xy_m, levels.nest_yaw_rad)
     mass, friction = {}, {}
-    for plate in world.plates:
+    for plate in world.plates:  # the keys, in the file's order
         mass[plate.labware_id] = 1.0 + _clipped_normal(rng, levels.plate_mass_spread)
         friction[plate.labware_id] = 1.0 + _clipped_normal(rng, levels.plate_friction_spread)
     return TrialDisturbance(seed, levels, navigation, station, marker, nest, mass, friction)

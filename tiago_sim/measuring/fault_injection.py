@@ -14,6 +14,7 @@ from typing import Any
 
 import pybullet as p
 
+from labware_model.holders import Nest
 from tiago_sim.lab.world import World
 from tiago_sim.transforms import make_transform, to_pose
 
@@ -98,7 +99,7 @@ class PlateFaults:
             return True
         if abs(sim.base.v) < DRIVING_SPEED_M_S:
             return False
-        slot = next((index for index, found, _ in sim.hotel_occupancy() if found == labware_id), 0)
+        slot = next((r.slot.index for r in sim.hotel_readings() if r.labware_id == labware_id), 0)
         if not slot:
             return False
         T_world_slot = sim.robot.link_pose(f"hotel_slot_{slot}")
@@ -118,12 +119,11 @@ class PlateFaults:
     def restore(self, sim: Any) -> None:
         """Put faulted plates back at their world-file nests (skipped where a plate already sits)."""
         self.drop_armed = ""
-        for plate in sim.world.plates:
-            if plate.labware_id not in self.faulted or not plate.station:
+        for plate, holder in sim.world.plates.items():
+            if plate.labware_id not in self.faulted or not isinstance(holder, Nest):
                 continue
-            T_world_site = sim.world.station(plate.station).T_world_site(plate.sub_position)
-            nest = (plate.station, plate.sub_position)
-            if any((name, sub) == nest and occupied for name, sub, occupied, _ in sim.nest_occupancy()):
+            T_world_site = sim.world.station(holder.station).T_world_site(holder.sub_position)
+            if any(reading.nest == holder and reading.occupied for reading in sim.nest_readings()):
                 log.warning("not restoring %s: its nest is taken", plate.labware_id)
                 continue
             labware = sim.scene.plate_types[plate.labware_id]
@@ -131,7 +131,7 @@ class PlateFaults:
             position, quat = to_pose(T_world_site @ centre)
             _teleport(sim, sim.scene.plates[plate.labware_id], position.tolist(), quat.tolist())
             self.faulted.discard(plate.labware_id)
-            log.info("plate %s restored to %s/%d", plate.labware_id, plate.station, plate.sub_position)
+            log.info("plate %s restored to %s", plate.labware_id, holder)
 
     @staticmethod
     def _body(sim: Any, labware_id: str) -> int:

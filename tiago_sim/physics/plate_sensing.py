@@ -9,12 +9,13 @@ control. Lives on the sim thread.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 import pybullet as p
 
+from labware_model.holders import FLOOR, GRIPPER, UNKNOWN, HotelSlot, Location, Nest
+from labware_model.readings import HotelSlotReading, NestReading, PlacementCheck
 from tiago_sim import transforms as tf
 from tiago_sim.lab.world import World
 from tiago_sim.physics.robot_body import RobotBody
@@ -29,18 +30,6 @@ PLACED_TILT_TOLERANCE_DEG = 1.0
 NEST_SENSOR_RANGE = 0.02  # m: presence sensor sees a plate whose centre is this close to the site
 
 
-@dataclass(frozen=True)
-class PlacementCheck:
-    """Ground truth about one plate (CheckPlacement service)."""
-
-    found: bool
-    in_nest: bool
-    position_error_m: float
-    yaw_error_rad: float
-    location: str
-    outside: str = ""  # in the expected nest but not in_nest: every limit it missed
-
-
 class PlateSensing:
     """Presence sensors and the placement check over one scene (see the module docstring)."""
 
@@ -52,7 +41,7 @@ class PlateSensing:
         self._robot = robot
         self._scene = scene
         self._grippers = grippers
-        self._nest_sites_cache: list[tuple[str, int, np.ndarray]] | None = None
+        self._nest_sites_cache: list[tuple[Nest, np.ndarray]] | None = None
 
     def plate_bottom(self, labware_id: str) -> np.ndarray:
         body = self._scene.plates[labware_id]
@@ -80,41 +69,41 @@ class PlateSensing:
                 return labware_id
         return ""
 
-    def _nest_sites(self) -> list[tuple[str, int, np.ndarray]]:
-        """(station, sub-position, T_world_site) of every nest; the stations never move, so computed once."""
+    def _nest_sites(self) -> list[tuple[Nest, np.ndarray]]:
+        """(nest, T_world_site) of every nest; the stations never move, so computed once."""
         if self._nest_sites_cache is None:
             self._nest_sites_cache = [
-                (station.name, sub, station.T_world_site(sub))
+                (nest, station.T_world_site(nest.sub_position))
                 for station in self._world.stations
-                for sub in range(1, station.sub_positions + 1)
+                for nest in station.nests()
             ]
         return self._nest_sites_cache
 
-    def nest_occupancy(self) -> list[tuple[str, int, bool, str]]:
+    def nest_readings(self) -> list[NestReading]:
         bottoms = self._plate_bottom_points()
         result = []
-        for name, sub, T_world_site in self._nest_sites():
+        for nest, T_world_site in self._nest_sites():
             labware_id = self._plate_near(T_world_site, bottoms)
-            result.append((name, sub, bool(labware_id), labware_id))
+            result.append(NestReading(nest, bool(labware_id), labware_id))
         return result
 
-    def hotel_occupancy(self) -> list[tuple[int, str, str]]:
+    def hotel_readings(self) -> list[HotelSlotReading]:
         bottoms = self._plate_bottom_points()
         result = []
-        for slot in range(1, self._world.hotel_slots + 1):
-            labware_id = self._plate_near(self._robot.link_pose(f"hotel_slot_{slot}"), bottoms)
+        for index in range(1, self._world.hotel_slots + 1):
+            labware_id = self._plate_near(self._robot.link_pose(f"hotel_slot_{index}"), bottoms)
             labware_type = self._scene.plate_types[labware_id].name if labware_id else ""
-            result.append((slot, labware_id, labware_type))
+            result.append(HotelSlotReading(HotelSlot(index), labware_id, labware_type))
         return result
 
-    def check_placement(self, labware_id: str, station: str, sub_position: int) -> PlacementCheck:
+    def check_placement(self, labware_id: str, nest: Nest | None) -> PlacementCheck:
         if labware_id not in self._scene.plates:
-            return PlacementCheck(False, False, math.inf, math.inf, "unknown")
+            return PlacementCheck(False, False, math.inf, math.inf, UNKNOWN)
         location = self._locate(labware_id)
-        if not station:
+        if nest is None:
             return PlacementCheck(True, False, math.nan, math.nan, location)
-        site = self._world.station(station)
-        offset = self._site_offset(site.T_world_site(sub_position), labware_id)
+        site = self._world.station(nest.station)
+        offset = self._site_offset(site.T_world_site(nest.sub_position), labware_id)
         position_error = float(np.linalg.norm(offset[:2, 3]))
         yaw_error = abs(tf.wrap_angle(tf.yaw_of(offset)))
         tilt = tf.rotation_angle(np.eye(3), offset[:3, :3]) - yaw_error
@@ -134,16 +123,16 @@ class PlateSensing:
         outside = ", ".join(missed)
         return PlacementCheck(True, not missed, position_error, float(yaw_error), location, outside)
 
-    def _locate(self, labware_id: str) -> str:
+    def _locate(self, labware_id: str) -> Location:
         for _side, gripper in self._grippers.items():
             if gripper.attached_id == labware_id or gripper.touching() == labware_id:
-                return "gripper"
-        for name, sub, _, found in self.nest_occupancy():
-            if found == labware_id:
-                return f"station:{name}:{sub}"
-        for slot, found, _ in self.hotel_occupancy():
-            if found == labware_id:
-                return f"hotel:{slot}"
+                return GRIPPER
+        for nest_reading in self.nest_readings():
+            if nest_reading.labware_id == labware_id:
+                return nest_reading.nest
+        for slot_reading in self.hotel_readings():
+            if slot_reading.labware_id == labware_id:
+                return slot_reading.slot
         if self.plate_bottom(labware_id)[2, 3] < 0.05:
-            return "floor"
-        return "unknown"
+            return FLOOR
+        return UNKNOWN

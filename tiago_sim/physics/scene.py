@@ -17,8 +17,10 @@ from dataclasses import dataclass, field
 import numpy as np
 import pybullet as p
 
+from labware_model.holders import HotelSlot, Nest
+from labware_model.labware import LabwareType
 from tiago_sim import transforms as tf
-from tiago_sim.lab.world import LabwareType, Station, World
+from tiago_sim.lab.world import Station, World
 from tiago_sim.perception.marker_asset import marker_visual
 from tiago_sim.robot.robot_model import BASE_RADIUS
 
@@ -42,7 +44,7 @@ class Scene:
     floor: int = -1
     dock: int = -1
     tables: dict[str, int] = field(default_factory=dict)
-    nests: dict[tuple[str, int], int] = field(default_factory=dict)
+    nests: dict[Nest, int] = field(default_factory=dict)
     markers: dict[str, int] = field(default_factory=dict)
     plates: dict[str, int] = field(default_factory=dict)
     plate_types: dict[str, LabwareType] = field(default_factory=dict)
@@ -134,10 +136,10 @@ def _build_station(client: int, station: Station, labware: LabwareType, scene: S
     scene.markers[station.name] = marker_visual(client, station.marker_id, station.marker_size, T_world_tile)
     pocket = (labware.length + 2 * station.nest_clearance, labware.width + 2 * station.nest_clearance)
     boxes = nest_boxes(pocket[0], pocket[1])
-    for sub in range(1, station.sub_positions + 1):
-        nest = _compound_static(client, boxes, station.T_world_site(sub), [0.25, 0.25, 0.28, 1])
-        p.changeDynamics(nest, -1, lateralFriction=NEST_FRICTION, physicsClientId=client)
-        scene.nests[(station.name, sub)] = nest
+    for nest in station.nests():
+        body = _compound_static(client, boxes, station.T_world_site(nest.sub_position), [0.25, 0.25, 0.28, 1])
+        p.changeDynamics(body, -1, lateralFriction=NEST_FRICTION, physicsClientId=client)
+        scene.nests[nest] = body
 
 
 def _plate_body(client: int, labware: LabwareType, T_world_bottom: np.ndarray) -> int:
@@ -186,14 +188,14 @@ def build_scene(client: int, world: World, T_world_hotel_slots: dict[int, np.nda
     default_type = next(iter(world.labware_types.values()))
     for station in world.stations:
         _build_station(client, station, default_type, scene)
-    for plate in world.plates:
+    for plate, holder in world.plates.items():
         labware = world.labware_types[plate.labware_type]
-        if plate.hotel_slot:
+        if isinstance(holder, HotelSlot):
             if T_world_hotel_slots is None:
                 raise ValueError(f"plate {plate.labware_id} starts in the hotel but no slot poses were given")
-            T_world_bottom = T_world_hotel_slots[plate.hotel_slot]
+            T_world_bottom = T_world_hotel_slots[holder.index]
         else:
-            T_world_bottom = world.station(plate.station).T_world_site(plate.sub_position)
+            T_world_bottom = world.station(holder.station).T_world_site(holder.sub_position)
         scene.plates[plate.labware_id] = _plate_body(client, labware, T_world_bottom)
         scene.plate_types[plate.labware_id] = labware
     return scene

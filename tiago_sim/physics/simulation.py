@@ -16,6 +16,8 @@ import time
 import numpy as np
 import pybullet as p
 
+from labware_model.holders import Nest
+from labware_model.readings import HotelSlotReading, NestReading, PlacementCheck
 from tiago_sim.lab.world import World
 from tiago_sim.perception.camera import CameraIntrinsics, render_rgbd
 from tiago_sim.physics.arm_controller import JointTrajectoryMotion
@@ -23,7 +25,7 @@ from tiago_sim.physics.base_controller import DiffDriveBase, DriveMotion
 from tiago_sim.physics.gripper_controller import Gripper, GripperMotion
 from tiago_sim.physics.hotel_clamp import HotelClamp
 from tiago_sim.physics.motion import BUSY, CompletedMotion, FailedMotion, Motion, SequenceMotion
-from tiago_sim.physics.plate_sensing import PlacementCheck, PlateSensing
+from tiago_sim.physics.plate_sensing import PlateSensing
 from tiago_sim.physics.robot_body import RobotBody
 from tiago_sim.physics.scene import build_scene
 from tiago_sim.physics.step_ledger import StepLedger
@@ -264,13 +266,13 @@ class Simulation:
         rgb, depth = render_rgbd(self.client_id, T_world_optical, intrinsics, supersample=supersample)
         return rgb, depth, intrinsics
 
-    def nest_occupancy(self) -> list[tuple[str, int, bool, str]]:
-        """(station, sub-position, occupied, labware id) per nest, as each nest's presence sensor sees it."""
-        return self.plate_sensing.nest_occupancy()
+    def nest_readings(self) -> list[NestReading]:
+        """Every nest, as its presence sensor sees it (a plate there, and which one)."""
+        return self.plate_sensing.nest_readings()
 
-    def hotel_occupancy(self) -> list[tuple[int, str, str]]:
-        """(slot, labware id, labware type) per hotel pocket, as its presence sensor sees it."""
-        return self.plate_sensing.hotel_occupancy()
+    def hotel_readings(self) -> list[HotelSlotReading]:
+        """Every hotel pocket, as its presence sensor sees it (the plate's id and type, or "")."""
+        return self.plate_sensing.hotel_readings()
 
     def plate_bottom_pose(self, labware_id: str) -> np.ndarray:
         """T_world_bottom of a plate (its bottom face centre): physics ground truth."""
@@ -382,7 +384,7 @@ class Simulation:
         return self._start(GripperMotion(self.grippers[arm], close))
 
     # ----------------------------------------------------------------- ground truth
-    def check_placement(self, labware_id: str, station: str, sub_position: int) -> PlacementCheck:
-        """Where a plate really is, and whether it rests in that nest within tolerance (success
-        checks only, never robot control)."""
-        return self.plate_sensing.check_placement(labware_id, station, sub_position)
+    def check_placement(self, labware_id: str, nest: Nest | None = None) -> PlacementCheck:
+        """Where a plate really is, and whether it rests in `nest` within tolerance (success
+        checks only, never robot control). Raises KeyError for a nest the world does not have."""
+        return self.plate_sensing.check_placement(labware_id, nest)

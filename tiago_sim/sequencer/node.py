@@ -40,12 +40,12 @@ from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.task import Future
 
+from labware_model.workcell import StationDescription, WorkcellDescription
 from tiago_sim.node_main import spin_node
 from tiago_sim.sequencer.plans import (
     STATE_REFUSALS,
     Step,
     TaskRefused,
-    Workcell,
     get_plan,
     put_plan,
     retreat_after_empty_grasp,
@@ -119,7 +119,7 @@ class Sequencer:
             node.declare_parameter(f"estimates_s.{action}", float(seconds))
         self.clients = {name: ActionClient(node, kind, topic) for name, (kind, topic) in SUB_ACTIONS.items()}
         self.describe_client = node.create_client(DescribeWorkcell, "/describe_workcell")
-        self.workcell: Workcell | None = None
+        self.workcell: WorkcellDescription | None = None
         self.robot_state: RobotState | None = None
         self.station_states: StationStates | None = None
         self.state_times: dict[str, float] = {}
@@ -183,12 +183,17 @@ class Sequencer:
                 raise StepFailed(ErrorCodes.INTERNAL, f"robot not available: {what} does not answer")
             await self._sleep(0.1)
 
-    async def _describe(self) -> Workcell:
+    async def _describe(self) -> WorkcellDescription:
         if self.workcell is None:
             await self._wait_ready("/describe_workcell", self.describe_client.service_is_ready)
             response = await self.describe_client.call_async(DescribeWorkcell.Request())
-            self.workcell = Workcell(
-                {s.name: (int(s.sub_positions), s.poi) for s in response.stations}, int(response.hotel_slots)
+            self.workcell = WorkcellDescription(
+                stations=tuple(
+                    StationDescription(s.name, int(s.sub_positions), s.poi) for s in response.stations
+                ),
+                hotel_slots=int(response.hotel_slots),
+                pois=tuple(response.pois),
+                dock_poi=response.dock_poi,
             )
         return self.workcell
 

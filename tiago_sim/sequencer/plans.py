@@ -1,7 +1,8 @@
 """The sub-action plans of GetLabware and PutLabware, and the checks before a plan starts.
 
 Pure data: a plan is a list of Steps (which action, which goal fields, an estimated duration),
-built from the goal and what the robot and stations report. The sequencer node runs it.
+built from the goal, the workcell /describe_workcell reported (a `WorkcellDescription` of the
+labware model) and what the robot and stations report. The sequencer node runs it.
 Safe on any thread.
 """
 
@@ -11,6 +12,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from labware_interfaces.msg import ErrorCodes, RobotState
+
+from labware_model.holders import HotelSlot, Nest
+from labware_model.workcell import WorkcellDescription
 
 # Refusals that rest on what the state topics say (a slot or nest full or empty), not on the goal.
 STATE_REFUSALS = frozenset(
@@ -40,45 +44,49 @@ class Step:
 
 
 @dataclass(frozen=True)
-class Workcell:
-    """What /describe_workcell reported."""
+class CheckedGoal:
+    """A goal's places, once they are known to exist: the nest, the hotel slot, the station's POI."""
 
-    stations: dict[str, tuple[int, str]]  # name -> (sub_positions, poi)
-    hotel_slots: int
+    nest: Nest
+    hotel_slot: HotelSlot
+    poi: str
 
 
-def check_common(goal: Any, workcell: Workcell) -> tuple[int, str]:
-    """Station, sub-position and hotel slot exist; returns (sub_positions, poi)."""
-    if goal.handover_position not in workcell.stations:
-        known = ", ".join(sorted(workcell.stations))
+def check_common(goal: Any, workcell: WorkcellDescription) -> CheckedGoal:
+    """Station, sub-position and hotel slot exist; returns them with the station's POI."""
+    station = workcell.station(goal.handover_position)
+    if station is None:
+        known = ", ".join(sorted(s.name for s in workcell.stations))
         raise TaskRefused(
             ErrorCodes.UNKNOWN_STATION, f"unknown station {goal.handover_position!r}: known are {known}"
         )
-    sub_positions, poi = workcell.stations[goal.handover_position]
-    if not 1 <= goal.sub_position <= sub_positions:
+    if not 1 <= goal.sub_position <= station.sub_positions:
         raise TaskRefused(
             ErrorCodes.UNKNOWN_SLOT,
-            f"station {goal.handover_position} has sub-positions 1..{sub_positions}, not {goal.sub_position}",
+            f"station {goal.handover_position} has sub-positions 1..{station.sub_positions}, "
+            f"not {goal.sub_position}",
         )
     if not 1 <= goal.internal_position <= workcell.hotel_slots:
         raise TaskRefused(
             ErrorCodes.UNKNOWN_SLOT,
             f"unknown hotel slot {goal.internal_position}: the robot has 1..{workcell.hotel_slots}",
         )
-    return sub_positions, poi
+    return CheckedGoal(Nest(station.name, goal.sub_position), HotelSlot(goal.internal_position), station.poi)
 
 
-def nest_state(station_states: Any, station: str, sub_position: int) -> Any | None:
-    for nest in station_states.nests:
-        if nest.station == station and nest.sub_position == sub_position:
-            return nest
+def nest_state(station_states: Any, nest: Nest) -> Any | None:
+    """The NestState message of `nest` in a StationStates message, if it reports that nest."""
+    for state in station_states.nests:
+        if state.station == nest.station and state.sub_position == nest.sub_position:
+            return state
     return None
 
 
-def hotel_slot(robot_state: Any, index: int) -> Any | None:
-    for slot in robot_state.hotel:
-        if slot.index == index:
-            return slot
+def hotel_slot_state(robot_state: Any, slot: HotelSlot) -> Any | None:
+    """The HotelSlot message of `slot` in a RobotState message, if it reports that slot."""
+    for state in robot_state.hotel:
+        if state.index == slot.index:
+            return state
     return None
 
 
@@ -95,23 +103,31 @@ def travel_steps(robot_state: Any, poi: str) -> list[Step]:
     return steps
 
 
-def get_plan(goal: Any, workcell: Workcell, robot_state: Any, station_states: Any, arm: str) -> list[Step]:
+def _goal_fields(checked: CheckedGoal, arm: str) -> tuple[dict[str, Any], dict[str, Any]]:
+    """The goal fields of the nest's MarkerMotion steps and of the hotel slot's PlayMotion steps."""
+    site = {"station": checked.nest.station, "sub_position": checked.nest.sub_position, "arm": arm}
+    hotel = {"hotel_slot": checked.hotel_slot.index, "arm": arm}
+    return site, hotel
+
+
+def get_plan(
+    goal: Any, workcell: WorkcellDescription, robot_state: Any, station_states: Any, arm: str
+) -> list[Step]:
     """Checks, then the steps that take a plate from a station nest into a hotel slot."""
-    _, poi = check_common(goal, workcell)
-    slot = hotel_slot(robot_state, goal.internal_position)
+    checked = check_common(goal, workcell)
+    slot = hotel_slot_state(robot_state, checked.hotel_slot)
     if slot is not None and slot.labware_id:
         raise TaskRefused(
             ErrorCodes.SLOT_OCCUPIED, f"hotel slot {goal.internal_position} already holds {slot.labware_id}"
         )
-    nest = nest_state(station_states, goal.handover_position, goal.sub_position)
+    nest = nest_state(station_states, checked.nest)
     if nest is None or not nest.occupied:
         raise TaskRefused(
             ErrorCodes.GRASP_FAILED, f"no plate at source {goal.handover_position}:{goal.sub_position}"
         )
-    site = {"station": goal.handover_position, "sub_position": goal.sub_position, "arm": arm}
-    hotel = {"hotel_slot": goal.internal_position, "arm": arm}
+    site, hotel = _goal_fields(checked, arm)
     return [
-        *travel_steps(robot_state, poi),
+        *travel_steps(robot_state, checked.poi),
         Step("marker_motion", {**site, "target": "work_pose"}, "final approach"),
         Step("play_motion", {"motion_name": "Benchtop", "arm": arm}, "arm to bench"),
         Step("gripper", {"command": "open", "arm": arm}, "opening"),
@@ -127,23 +143,24 @@ def get_plan(goal: Any, workcell: Workcell, robot_state: Any, station_states: An
     ]
 
 
-def put_plan(goal: Any, workcell: Workcell, robot_state: Any, station_states: Any, arm: str) -> list[Step]:
+def put_plan(
+    goal: Any, workcell: WorkcellDescription, robot_state: Any, station_states: Any, arm: str
+) -> list[Step]:
     """Checks, then the steps that take a plate from a hotel slot into a station nest."""
-    _, poi = check_common(goal, workcell)
-    nest = nest_state(station_states, goal.handover_position, goal.sub_position)
+    checked = check_common(goal, workcell)
+    nest = nest_state(station_states, checked.nest)
     if nest is not None and nest.occupied:
         holder = f" (holds {nest.labware_id})" if nest.labware_id else ""
         raise TaskRefused(
             ErrorCodes.NEST_OCCUPIED,
             f"destination {goal.handover_position}:{goal.sub_position} is occupied{holder}",
         )
-    slot = hotel_slot(robot_state, goal.internal_position)
+    slot = hotel_slot_state(robot_state, checked.hotel_slot)
     if slot is None or not slot.labware_id:
         raise TaskRefused(ErrorCodes.SLOT_EMPTY, f"hotel slot {goal.internal_position} holds no plate")
-    site = {"station": goal.handover_position, "sub_position": goal.sub_position, "arm": arm}
-    hotel = {"hotel_slot": goal.internal_position, "arm": arm}
+    site, hotel = _goal_fields(checked, arm)
     return [
-        *travel_steps(robot_state, poi),
+        *travel_steps(robot_state, checked.poi),
         Step("marker_motion", {**site, "target": "work_pose"}, "final approach"),
         Step("gripper", {"command": "open", "arm": arm}, "opening"),
         Step("play_motion", {"motion_name": "NestApproach", **hotel}, "to hotel"),

@@ -33,6 +33,7 @@ from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
+from labware_model.holders import UNKNOWN, Nest, location_text
 from tiago_sim.lab.world import DEFAULT_WORLD, World, WorldError, load_world
 from tiago_sim.measuring.fault_injection import Occluders, PlateFaults
 from tiago_sim.node_main import spin_node
@@ -161,30 +162,29 @@ class SimNode:
 
     # -- services -------------------------------------------------------------------------
     def _describe_workcell(self, _request: Any, response: Any) -> Any:
+        workcell = self.world.describe_workcell()
         response.stations = [
-            StationInfo(name=s.name, sub_positions=s.sub_positions, poi=s.poi) for s in self.world.stations
+            StationInfo(name=s.name, sub_positions=s.sub_positions, poi=s.poi) for s in workcell.stations
         ]
-        response.hotel_slots = self.world.hotel_slots
-        response.pois = sorted(self.world.pois)
-        response.dock_poi = self.world.dock_poi
+        response.hotel_slots = workcell.hotel_slots
+        response.pois = list(workcell.pois)
+        response.dock_poi = workcell.dock_poi
         return response
 
     def _check_placement(self, request: Any, response: Any) -> Any:
+        """Ground truth about a plate; an empty station asks about no nest."""
         try:
-            check = self.sim_thread.run(
-                lambda sim: sim.check_placement(
-                    request.labware_id, request.station, int(request.sub_position)
-                )
-            )
+            nest = Nest(request.station, int(request.sub_position)) if request.station else None
+            check = self.sim_thread.run(lambda sim: sim.check_placement(request.labware_id, nest))
         except Exception as error:  # noqa: BLE001 - answer "unknown" rather than fail the call
             log.warning("check_placement failed: %s", error)
-            response.found, response.location = False, "unknown"
+            response.found, response.location = False, location_text(UNKNOWN)
             return response
         response.found = bool(check.found)
         response.in_nest = bool(check.in_nest)
         response.position_error_m = float(check.position_error_m)
         response.yaw_error_rad = float(check.yaw_error_rad)
-        response.location = str(check.location)
+        response.location = location_text(check.location)
         response.outside = str(check.outside)
         return response
 

@@ -24,6 +24,7 @@ from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import CameraInfo, Image, JointState
 
+from labware_model.readings import HotelSlotReading, NestReading
 from tiago_sim.sim_node.sim_thread import SimThread
 from tiago_sim.transforms import wrap_angle
 
@@ -42,9 +43,9 @@ class RobotSnapshot:
     odometry: tuple[float, float, float]
     joint_positions: dict[str, float]
     docked: bool
-    hotel: list[tuple[int, str, str]]
+    hotel: list[HotelSlotReading]
     held_labware_id: str
-    nests: list[tuple[str, int, bool, str]] = field(default_factory=list)
+    nests: list[NestReading] = field(default_factory=list)
     true_base_pose: tuple[float, float, float] | None = None  # simulator truth, for measurement only
     activity: tuple[str, str] = ("", "")  # (state or "", detail) of the action servers at that instant
 
@@ -59,9 +60,9 @@ def take_snapshot(sim: Any) -> RobotSnapshot:
         odometry=tuple(float(v) for v in sim.odometry()),
         joint_positions=dict(sim.joint_positions()),
         docked=bool(sim.is_docked()),
-        hotel=list(sim.hotel_occupancy()),
+        hotel=list(sim.hotel_readings()),
         held_labware_id=held,
-        nests=list(sim.nest_occupancy()),
+        nests=list(sim.nest_readings()),
         true_base_pose=_true_base_pose(sim),
     )
 
@@ -79,9 +80,13 @@ def _true_base_pose(sim: Any) -> tuple[float, float, float] | None:
     )
 
 
-def _occupied_nests(nests: tuple) -> str:
+def _occupied_nests(nests: tuple[NestReading, ...]) -> str:
     """'station_a:1=plate_001, ...' for the log: which nests hold which plate."""
-    return ", ".join(f"{station}:{sub}={plate}" for station, sub, occupied, plate in nests if occupied)
+    return ", ".join(
+        f"{reading.nest.station}:{reading.nest.sub_position}={reading.labware_id}"
+        for reading in nests
+        if reading.occupied
+    )
 
 
 def stamp_of(sim_time: float) -> Time:
@@ -233,8 +238,10 @@ class StatePublishers:
         x, y, yaw = snapshot.odometry
         message.base_pose = Pose2D(x=x, y=y, theta=yaw)
         message.hotel = [
-            HotelSlot(index=int(index), labware_id=labware_id, labware_type=labware_type)
-            for index, labware_id, labware_type in snapshot.hotel
+            HotelSlot(
+                index=reading.slot.index, labware_id=reading.labware_id, labware_type=reading.labware_type
+            )
+            for reading in snapshot.hotel
         ]
         message.held_labware_id = snapshot.held_labware_id
         return message
@@ -244,9 +251,12 @@ class StatePublishers:
         return StationStates(
             nests=[
                 NestState(
-                    station=station, sub_position=int(sub), occupied=bool(occupied), labware_id=labware_id
+                    station=reading.nest.station,
+                    sub_position=reading.nest.sub_position,
+                    occupied=bool(reading.occupied),
+                    labware_id=reading.labware_id,
                 )
-                for station, sub, occupied, labware_id in snapshot.nests
+                for reading in snapshot.nests
             ]
         )
 

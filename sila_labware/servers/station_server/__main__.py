@@ -6,8 +6,8 @@ from __future__ import annotations
 import argparse
 import sys
 
+from labware_model.workcell import WorkcellDescription
 from ros_bridge.robot_link import RobotLink
-from ros_bridge.workcell import WorkcellDescription
 from sila_labware.device.station_controller import StationController
 from sila_labware.servers.standalone import run_standalone, standalone_parser
 

@@ -28,6 +28,7 @@ from rclpy.qos import QoSProfile
 from sensor_msgs.msg import JointState
 from sila2.framework import DefinedExecutionError
 
+from labware_model.holders import FLOOR, Nest
 from ros_bridge.topics import TopicMirror
 from tests.helpers.sila_stack import DEFAULT_WORLD, start_stack
 from tests.helpers.sim_parameters import set_node_parameter
@@ -80,7 +81,7 @@ def expect_error(identifier: str, instance_or_call, match: str) -> DefinedExecut
 
 def wait_nest(cell: Cell, nest: tuple[str, int], occupied: bool) -> None:
     assert cell.deployment.link is not None
-    cell.deployment.link.wait_for_nest(nest[0], nest[1], occupied, timeout_s=5.0)
+    cell.deployment.link.wait_for_nest(Nest(*nest), occupied, timeout_s=5.0)
 
 
 def assert_lost(cell: Cell, plate: str) -> None:
@@ -147,8 +148,8 @@ def test_plate_dropped_mid_drive_is_labware_not_placed_and_reported_lost(cell: C
         assert f"plate {PLATE} slipped out of hotel slot 1 mid-drive" in sim_log(cell)
         assert_lost(cell, PLATE)
         assert cell.deployment.link is not None
-        truth = cell.deployment.link.check_placement(PLATE, "", 0)  # ground truth, for the check only
-        assert truth.location == "floor", truth
+        truth = cell.deployment.link.check_placement(PLATE)  # ground truth, for the check only
+        assert truth.location == FLOOR, truth
         # The destination station does not claim a delivery its sensor does not see.
         expect_error(
             "InvalidCommandSequence",

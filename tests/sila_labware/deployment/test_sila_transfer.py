@@ -9,6 +9,7 @@ from collections.abc import Iterator
 
 import pytest
 
+from labware_model.holders import Nest
 from sila_labware.deployment.demo import run_demo
 from sila_labware.deployment.stack import Deployment
 from tests.helpers.sila_stack import client_for, start_stack
@@ -49,8 +50,8 @@ def test_plate_moves_from_station_a_to_station_b(stack: Deployment) -> None:
     location = robot.LabwareInventory.LocateLabware(LabwareUniqueID="plate_001").Location
     assert (location.Aboard, location.Position, location.Index) == (False, "station_b", 1)
     assert robot.MobileRobotController.OnboardLabware.get() == []
-    nests = {(nest.station, nest.sub_position): nest.occupied for nest in stack.link.nest_occupancies()}
-    assert nests[("station_a", 1)] is False and nests[("station_b", 1)] is True
+    nests = {reading.nest: reading.occupied for reading in stack.link.nest_readings()}
+    assert nests[Nest("station_a", 1)] is False and nests[Nest("station_b", 1)] is True
     assert "Navigating" in states and "Manipulating" in states, states
 
     # The protocol starts over: the robot is idle, and station_b now refuses input at the full nest.

@@ -15,14 +15,13 @@ from collections.abc import Callable
 
 import pytest
 
+from labware_model.holders import GRIPPER, UNKNOWN, HotelSlot, Nest
+from labware_model.workcell import StationDescription, WorkcellDescription
 from ros_bridge.robot_link import RobotLink
-from ros_bridge.workcell import StationDescription, WorkcellDescription
 from sila_labware.device.errors import CommandSequenceError, MotionFailed, ParameterError, TransferFailed
-from sila_labware.device.inventory import GRIPPER, UNKNOWN, at_station, in_hotel
 from sila_labware.device.robot_backend import RobotBackend, StationBackend
 from sila_labware.device.robot_controller import ControllerWaits, RobotController
 from sila_labware.device.station_controller import StationController
-from sila_labware.device.validation import Handover
 from tests.helpers.fake_robot import (
     FakeRobot,
     ends_when_cancelled,
@@ -228,7 +227,7 @@ def test_a_transfer_past_its_timeout_is_cancelled_and_settles_where_the_plate_is
     with pytest.raises(TransferFailed) as failed:
         controller.get_labware("reader", 1, [])
     assert failed.value.error_code == "CANCELED"
-    assert controller.inventory.locate("P1").location == at_station(Handover("reader", 1))
+    assert controller.inventory.locate("P1").location == Nest("reader", 1)
     assert controller.sequence.phase.value == "idle"
 
 
@@ -253,8 +252,8 @@ def test_a_successful_get_puts_the_plate_in_the_hotel_slot() -> None:
     controller.prepare_for_input("reader", 1, 2, "plate_96", "P1")
     assert controller.get_labware("reader", 1, []) == "P1"
     record = controller.inventory.locate("P1")
-    assert record.location == in_hotel(2) and record.labware_type == "plate_96"
-    assert fake.sent[0].argument.hotel_slot == 2
+    assert record.location == HotelSlot(2) and record.labware_type == "plate_96"
+    assert fake.sent[0].argument.hotel_slot == HotelSlot(2)
 
 
 def test_a_get_without_a_plate_id_records_the_id_the_robot_read() -> None:
@@ -263,7 +262,7 @@ def test_a_get_without_a_plate_id_records_the_id_the_robot_read() -> None:
     controller.prepare_for_input("reader", 1, 1, "", "")
     fake.script("get_labware", succeed(result=result_with_labware_id("P5")))
     assert controller.get_labware("reader", 1, []) == "P5"
-    assert controller.inventory.locate("P5").location == in_hotel(1)
+    assert controller.inventory.locate("P5").location == HotelSlot(1)
 
 
 def test_a_failed_get_with_the_plate_in_the_gripper_records_the_gripper() -> None:
@@ -293,7 +292,7 @@ def test_a_failed_get_that_never_touched_the_plate_leaves_it_in_the_nest() -> No
     fake.script("get_labware", fail("MARKER_NOT_FOUND"))
     with pytest.raises(TransferFailed):
         controller.get_labware("reader", 1, [])
-    assert controller.inventory.locate("P1").location == at_station(Handover("reader", 1))
+    assert controller.inventory.locate("P1").location == Nest("reader", 1)
 
 
 def test_a_successful_put_puts_the_plate_in_the_nest() -> None:
@@ -301,7 +300,7 @@ def test_a_successful_put_puts_the_plate_in_the_nest() -> None:
     controller = controller_on(fake)
     controller.prepare_for_output("rack", 2, 1)
     assert controller.put_labware("rack", 2, []) == "P1"
-    assert controller.inventory.locate("P1").location == at_station(Handover("rack", 2))
+    assert controller.inventory.locate("P1").location == Nest("rack", 2)
 
 
 def test_a_failed_put_that_dropped_the_plate_records_it_lost() -> None:
@@ -334,7 +333,7 @@ def test_the_supervisors_abort_ends_a_waiting_transfer_with_its_defined_error() 
     assert SUPERVISOR_REASON in failure.message
     assert fake.sent[0].cancel_requests == [], "nothing is sent to a robot side that is gone"
     assert controller.sequence.phase.value == "idle"
-    assert controller.inventory.locate("P1").location == at_station(Handover("reader", 1))
+    assert controller.inventory.locate("P1").location == Nest("reader", 1)
 
 
 def test_stop_motion_cancels_the_running_goal() -> None:

@@ -8,8 +8,8 @@ import time
 
 import pytest
 
+from labware_model.workcell import StationDescription, WorkcellDescription
 from ros_bridge.robot_link import RobotLink
-from ros_bridge.workcell import StationDescription, WorkcellDescription
 from sila_labware.device.errors import MotionFailed
 from sila_labware.device.robot_backend import RobotBackend, StationBackend
 from sila_labware.device.robot_controller import RobotController

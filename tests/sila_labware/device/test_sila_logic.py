@@ -6,9 +6,11 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from ros_bridge.workcell import HotelSlotContent, NestOccupancy, RobotStatus
+from labware_model.holders import GRIPPER, UNKNOWN, HotelSlot, Nest
+from labware_model.readings import HotelSlotReading, NestReading
+from ros_bridge.workcell import RobotStatus
 from sila_labware.device.errors import CommandSequenceError, ParameterError
-from sila_labware.device.inventory import GRIPPER, UNKNOWN, Inventory, at_station, in_hotel, observed_location
+from sila_labware.device.inventory import Inventory, observed_location
 from sila_labware.device.sequences import (
     ManipulatorPhase,
     ManipulatorSequence,
@@ -18,20 +20,21 @@ from sila_labware.device.sequences import (
 )
 from sila_labware.device.validation import (
     MAX_TEXT_LENGTH,
-    Handover,
     check_handover,
     check_intermediate_actions,
     check_internal_position,
     check_text,
 )
 
-READER = Handover("reader", 1)
-RACK_2 = Handover("rack", 2)
+READER = Nest("reader", 1)
+RACK_2 = Nest("rack", 2)
 STATIONS = {"reader": 1, "rack": 4}
 
 
 def robot_status(hotel: dict[int, str] | None = None, held: str = "") -> RobotStatus:
-    slots = tuple(HotelSlotContent(index, plate, "") for index, plate in (hotel or {1: "", 2: ""}).items())
+    slots = tuple(
+        HotelSlotReading(HotelSlot(index), plate, "") for index, plate in (hotel or {1: "", 2: ""}).items()
+    )
     return RobotStatus("idle", "", "", 0.0, 0.0, 0.0, slots, held)
 
 
@@ -160,7 +163,7 @@ def test_site_refuses_out_of_order_and_occupancy_conflicts() -> None:
 
 
 def test_parameter_errors_name_the_problem() -> None:
-    assert check_handover("rack", 4, STATIONS) == Handover("rack", 4)
+    assert check_handover("rack", 4, STATIONS) == Nest("rack", 4)
     with pytest.raises(ParameterError, match=r"handover position 'oven'; known positions: rack, reader"):
         check_handover("oven", 1, STATIONS)
     with pytest.raises(ParameterError, match=r"SubPosition 5 is beyond .*'rack'.*\(1..4\)") as caught:
@@ -185,27 +188,24 @@ def test_parameter_errors_name_the_problem() -> None:
 
 
 def test_observed_location_prefers_robot_reports_then_nest_sensors() -> None:
-    nests = (NestOccupancy("reader", 1, True, ""), NestOccupancy("rack", 2, True, "P9"))
-    assert observed_location("P1", READER, robot_status({1: "P1", 2: ""}), nests) == in_hotel(1)
+    nests = (NestReading(READER, True, ""), NestReading(RACK_2, True, "P9"))
+    assert observed_location("P1", READER, robot_status({1: "P1", 2: ""}), nests) == HotelSlot(1)
     assert observed_location("P1", READER, robot_status(held="P1"), nests) == GRIPPER
-    assert observed_location("P9", READER, robot_status(), nests) == at_station(RACK_2)
-    assert observed_location("P1", READER, robot_status(), nests) == at_station(READER)
-    assert observed_location("P1", RACK_2, robot_status(), (NestOccupancy("rack", 2, False, ""),)) == UNKNOWN
+    assert observed_location("P9", READER, robot_status(), nests) == RACK_2
+    assert observed_location("P1", READER, robot_status(), nests) == READER
+    assert observed_location("P1", RACK_2, robot_status(), (NestReading(RACK_2, False, ""),)) == UNKNOWN
 
 
 def test_inventory_stays_true_on_failure_and_notifies_changes() -> None:
     inventory = Inventory()
     snapshots: list[int] = []
     inventory.add_listener(lambda records: snapshots.append(len(records)))
-    inventory.record("P1", "plate", at_station(READER))
+    inventory.record("P1", "plate", READER)
     # A GetLabware that failed before the grasp: the reader's sensor still sees the plate.
-    where = inventory.settle("P1", "", READER, robot_status(), (NestOccupancy("reader", 1, True, ""),))
-    assert where == at_station(READER) and inventory.locate("P1").labware_type == "plate"
+    where = inventory.settle("P1", "", READER, robot_status(), (NestReading(READER, True, ""),))
+    assert where == READER and inventory.locate("P1").labware_type == "plate"
     # A GetLabware that dropped the plate: neither robot nor nest has it.
-    assert (
-        inventory.settle("P1", "", READER, robot_status(), (NestOccupancy("reader", 1, False, ""),))
-        == UNKNOWN
-    )
+    assert inventory.settle("P1", "", READER, robot_status(), (NestReading(READER, False, ""),)) == UNKNOWN
     inventory.observe_robot(robot_status({1: "", 2: "P2"}))
     assert inventory.in_hotel_slot(2).labware_id == "P2" and inventory.in_hotel_slot(1) is None
     assert [record.labware_id for record in inventory.records()] == ["P1", "P2"]

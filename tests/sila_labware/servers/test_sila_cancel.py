@@ -20,6 +20,7 @@ from typing import Any
 import pytest
 from sila2.framework import DefinedExecutionError
 
+from labware_model.holders import GRIPPER, HotelSlot, Location, Nest
 from tests.helpers.sila_stack import start_stack
 from tests.helpers.sim_parameters import set_node_parameter
 from tests.helpers.transfer_steps import Cell, finish, wait_for_progress
@@ -37,20 +38,20 @@ def cell(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Cell]:
     deployment.stop()
 
 
-def physical_location(cell: Cell) -> str:
-    """Where the simulation says the plate is: station:<name>:<sub>, hotel:<slot>, gripper, floor."""
+def physical_location(cell: Cell) -> Location:
+    """Where the simulation says the plate is: a nest, a hotel slot, the gripper, the floor."""
     assert cell.deployment.link is not None
     return cell.deployment.link.check_placement(PLATE).location
 
 
-def reported_location(cell: Cell) -> str:
-    """Where the robot server's inventory says the plate is, in the same notation."""
+def reported_location(cell: Cell) -> Location:
+    """Where the robot server's inventory says the plate is, read from its SiLA properties."""
     aboard, station, index = cell.location(PLATE)
     if not aboard:
-        return f"station:{station}:{index}"
+        return Nest(station, index)
     onboard = cell.robot.MobileRobotController.OnboardLabware.get()
     slots = [item.InternalPosition for item in onboard if item.LabwareUniqueID == PLATE]
-    return f"hotel:{slots[0]}" if slots else "gripper"
+    return HotelSlot(slots[0]) if slots else GRIPPER
 
 
 def cancel_mid_way(cell: Cell, get: Any) -> float:
@@ -91,19 +92,19 @@ def test_stop_motion_cancels_get_labware_and_everything_stays_consistent(cell: C
 
     # Inventory matches physics: the plate is in the source nest, in the hotel or held.
     where = physical_location(cell)
-    assert where in {"station:station_a:1", "hotel:1", "gripper"}, where
+    assert where in {Nest(*A1), HotelSlot(1), GRIPPER}, where
     assert reported_location(cell) == where
     occupied = cell.nest_occupied()
-    assert occupied[A1] == (where == "station:station_a:1")
+    assert occupied[A1] == (where == Nest(*A1))
     assert not occupied[B1]
 
     # A complete transfer follows. Station A is still prepared for output (its handover is open),
     # so the scheduler redoes the robot's part, then closes A and places in B.
-    assert where == "station:station_a:1", f"cancel landed after the grasp: plate at {where}"
+    assert where == Nest(*A1), f"cancel landed after the grasp: plate at {where}"
     cell.prepare_pick(A1, PLATE, station_too=False)
     cell.pick(A1)
     cell.place(B1, PLATE)
-    assert physical_location(cell) == "station:station_b:1"
-    assert reported_location(cell) == "station:station_b:1"
+    assert physical_location(cell) == Nest(*B1)
+    assert reported_location(cell) == Nest(*B1)
     assert cell.deployment.link is not None
-    assert cell.deployment.link.check_placement(PLATE, *B1).in_nest
+    assert cell.deployment.link.check_placement(PLATE, Nest(*B1)).in_nest

@@ -17,6 +17,7 @@ import pytest
 from sila.client import Client, ClientConfig
 from sila.framework import CommandExecutionInfo, DefinedExecutionError
 
+from labware_model.holders import Nest
 from sila_labware.deployment.stack import Deployment, ServedServer
 from tests.helpers.sila_stack import start_stack
 
@@ -185,11 +186,11 @@ def test_unitelabs_client_moves_the_plate_from_a_to_b(stack: Deployment) -> None
 
     # Physics ground truth: the plate rests in B's nest, A's nest is empty.
     assert stack.link is not None
-    placement = stack.link.check_placement(PLATE, *DESTINATION)
+    placement = stack.link.check_placement(PLATE, Nest(*DESTINATION))
     assert placement.found and placement.in_nest, placement
     assert placement.position_error_m < 0.005, placement
-    nests = {(nest.station, nest.sub_position): nest.occupied for nest in stack.link.nest_occupancies()}
-    assert nests[DESTINATION] and not nests[SOURCE]
+    nests = {reading.nest: reading.occupied for reading in stack.link.nest_readings()}
+    assert nests[Nest(*DESTINATION)] and not nests[Nest(*SOURCE)]
 
 
 def test_sila2_discovery_without_a_ca_file_trusts_the_announced_ca(stack: Deployment) -> None:

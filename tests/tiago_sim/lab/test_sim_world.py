@@ -9,6 +9,9 @@ import numpy as np
 import pytest
 import yaml
 
+from labware_model.holders import Nest
+from labware_model.labware import Plate
+from labware_model.workcell import StationDescription
 from tiago_sim import transforms as tf
 from tiago_sim.lab.world import DEFAULT_WORLD, WorldError, load_world
 from tiago_sim.robot import robot_model
@@ -22,13 +25,23 @@ def test_default_world_loads_with_two_distant_stations_a_dock_and_a_plate():
     distance = np.linalg.norm(a.T_world_site(1)[:2, 3] - b.T_world_site(1)[:2, 3])
     assert distance >= 3.0
     assert world.dock_poi in world.pois and a.poi in world.pois and b.poi in world.pois
-    assert [(p.labware_id, p.station, p.sub_position) for p in world.plates] == [
-        ("plate_001", "station_a", 1)
-    ]
+    assert dict(world.plates) == {Plate("plate_001", "sbs_microplate_96"): Nest("station_a", 1)}
     plate = world.labware_types["sbs_microplate_96"]
     assert (plate.length, plate.width, plate.height) == (0.12776, 0.08548, 0.01435)
     for station in world.stations:
         assert station.marker_id not in (8, 9, 17, 47) and station.marker_size >= 0.10
+
+
+def test_the_world_names_nests_plates_and_the_workcell_in_the_labware_model():
+    world = load_world()
+    assert world.station("station_b").nests() == (Nest("station_b", 1), Nest("station_b", 2))
+    workcell = world.describe_workcell()
+    assert workcell.stations == (
+        StationDescription("station_a", 2, "station_a_work"),
+        StationDescription("station_b", 2, "station_b_work"),
+    )
+    assert workcell.hotel_slots == 2 and workcell.dock_poi == world.dock_poi
+    assert workcell.pois == tuple(sorted(world.pois))
 
 
 def test_work_poi_stands_in_front_of_the_nests_facing_them():
@@ -62,6 +75,16 @@ def _write(tmp_path: Path, mutate) -> Path:
             "integer",
         ),
         (lambda d: d["plates"][0].update(station="nowhere"), "plates[0].station", "unknown station"),
+        (
+            lambda d: d["plates"].append({**d["plates"][0], "id": "plate_002"}),
+            "plates[1]",
+            "('station_a', 1) already holds a plate",
+        ),
+        (
+            lambda d: d["plates"].append({"id": "plate_001", "type": "sbs_microplate_96", "hotel_slot": 2}),
+            "plates[1].id",
+            "duplicate plate id",
+        ),
         (lambda d: d["stations"][1].update(name="station_a"), "stations[1].name", "duplicate"),
         (lambda d: d["dock"].update(pose=[1, 2]), "dock.pose", "list of 3 numbers"),
     ],

@@ -13,6 +13,8 @@ import numpy as np
 import pybullet as p
 import pytest
 
+from labware_model.holders import GRIPPER, HotelSlot, Nest
+from labware_model.readings import HotelSlotReading, NestReading
 from tests.helpers.sim_steps import step_for, step_lengths
 from tiago_sim import transforms as tf
 from tiago_sim.lab.world import load_world
@@ -86,31 +88,34 @@ def test_plate_goes_from_station_a_through_the_hotel_to_station_b():
     sim = Simulation(world, seed=11)
     script = Script(sim)
     try:
-        assert sim.check_placement(PLATE, "station_a", 1).in_nest
+        assert sim.check_placement(PLATE, Nest("station_a", 1)).in_nest
         script.run(sim.undock(), "undock")
         script.drive("station_a_work")
         script.pick(script.site_in_base("station_a", 1))
-        assert sim.check_placement(PLATE, "", 0).location == "gripper"
-        assert sim.nest_occupancy()[0] == ("station_a", 1, False, "")
+        assert sim.check_placement(PLATE).location == GRIPPER
+        assert sim.nest_readings()[0] == NestReading(Nest("station_a", 1), False, "")
 
         T_base_slot = sim.kinematics.forward(sim.joint_positions(), "hotel_slot_1")
         script.place(T_base_slot)
-        assert sim.hotel_occupancy() == [(1, PLATE, "sbs_microplate_96"), (2, "", "")]
+        assert sim.hotel_readings() == [
+            HotelSlotReading(HotelSlot(1), PLATE, "sbs_microplate_96"),
+            HotelSlotReading(HotelSlot(2), "", ""),
+        ]
         home = dict(zip(rm.arm_joint_names(ARM), HOME_ARM, strict=True))
         script.run(sim.move_joints(home), "home")
 
         script.drive("station_b_work")
-        assert sim.check_placement(PLATE, "", 0).location == "hotel:1"  # it rode along in its pocket
+        assert sim.check_placement(PLATE).location == HotelSlot(1)  # it rode along in its pocket
         script.pick(T_base_slot)
         script.place(script.site_in_base("station_b", 1))
 
-        check = sim.check_placement(PLATE, "station_b", 1)
+        check = sim.check_placement(PLATE, Nest("station_b", 1))
         clearance = world.station("station_b").nest_clearance
         assert check.in_nest, check
-        assert check.location == "station:station_b:1"
+        assert check.location == Nest("station_b", 1)
         assert check.position_error_m < clearance * 1.5 + 0.001
         assert check.yaw_error_rad < np.radians(1.0)
-        assert ("station_b", 1, True, PLATE) in sim.nest_occupancy()
+        assert NestReading(Nest("station_b", 1), True, PLATE) in sim.nest_readings()
         assert max(script.slips_m) < 0.003, script.slips_m
     finally:
         sim.close()
@@ -136,7 +141,7 @@ def test_a_held_plate_takes_long_steps_in_free_space_and_short_ones_near_the_tab
         down = step_lengths(sim, lower)
         assert lower.success, lower
         assert down[0] == long_step and down[-20:] == [sim.time_step] * 20, down
-        assert sim.check_placement(PLATE, "", 0).location == "gripper"
+        assert sim.check_placement(PLATE).location == GRIPPER
     finally:
         sim.close()
 
@@ -165,7 +170,7 @@ def test_nest_lead_ins_guide_a_plate_released_off_centre():
         script.pick(script.site_in_base("station_a", 1))
         error = tf.from_xyz_rpy((-0.004, 0.003, 0.0), (0.0, 0.0, np.radians(1.5)))
         script.place(script.site_in_base("station_a", 2) @ error)
-        check = sim.check_placement(PLATE, "station_a", 2)
+        check = sim.check_placement(PLATE, Nest("station_a", 2))
         assert check.in_nest, check
         assert check.position_error_m < 0.0025
     finally:
@@ -203,7 +208,7 @@ def test_a_plate_arriving_at_the_pocket_edge_settles_flat_in_the_nest():
             for outwards_mm, yaw_deg in itertools.product(np.arange(-0.4, 1.65, 0.1), (0.0, 0.3)):
                 _rest_plate_on_pocket_edge(sim, side, outwards_mm / 1000, np.radians(yaw_deg))
                 step_for(sim, 2.0)
-                check = sim.check_placement(PLATE, "station_a", 2)
+                check = sim.check_placement(PLATE, Nest("station_a", 2))
                 if not check.in_nest:
                     where = f"side {side:+d}, {outwards_mm:.1f} mm out, yaw {yaw_deg} deg"
                     refused.append(f"{where}: {check.outside}")
@@ -229,7 +234,7 @@ def test_grasp_holds_a_plate_when_the_gripper_arrives_off_centre():
         before = script.plate_in_grasp()
         script.run(sim.move_tool(ARM, script.grasp(T_base_site, CARRY)), "lift")
         assert sim.held_labware(ARM) == PLATE
-        assert sim.check_placement(PLATE, "", 0).location == "gripper"
+        assert sim.check_placement(PLATE).location == GRIPPER
         assert np.linalg.norm(script.plate_in_grasp()[:3, 3] - before[:3, 3]) < 0.002
     finally:
         sim.close()

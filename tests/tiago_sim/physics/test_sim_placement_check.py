@@ -13,11 +13,12 @@ import numpy as np
 import pybullet as p
 import pytest
 
+from labware_model.holders import Nest
 from tiago_sim import transforms as tf
 from tiago_sim.lab.world import load_world
 from tiago_sim.physics.simulation import Simulation
 
-PLATE, STATION = "plate_001", "station_a"
+PLATE, NEST = "plate_001", Nest("station_a", 1)
 
 
 @pytest.fixture(scope="module")
@@ -30,7 +31,7 @@ def sim() -> Simulation:
 def _put_plate(sim: Simulation, T_site_plate_bottom: np.ndarray) -> None:
     """Place the plate so its bottom centre sits at that pose in the nest frame (no physics step)."""
     height = sim.scene.plate_types[PLATE].height
-    T_world_bottom = sim.world.station(STATION).T_world_site(1) @ T_site_plate_bottom
+    T_world_bottom = sim.world.station(NEST.station).T_world_site(NEST.sub_position) @ T_site_plate_bottom
     T_world_plate = T_world_bottom @ tf.make_transform((0.0, 0.0, height / 2))
     position, quaternion = tf.to_pose(T_world_plate)
     p.resetBasePositionAndOrientation(
@@ -52,7 +53,7 @@ def test_every_missed_limit_is_named(
     sim: Simulation, T_site_plate_bottom: np.ndarray, in_nest: bool, named: str
 ) -> None:
     _put_plate(sim, T_site_plate_bottom)
-    check = sim.check_placement(PLATE, STATION, 1)
-    assert check.location == f"station:{STATION}:1"
+    check = sim.check_placement(PLATE, NEST)
+    assert check.location == NEST
     assert check.in_nest is in_nest
     assert check.outside == named

@@ -49,7 +49,7 @@ def test_plate_in_the_hotel_rides_a_drive_clamped_at_long_steps_without_slipping
     sim = Simulation(world, seed=6)
     try:
         _put_plate_in_hotel(sim, 1)
-        assert sim.hotel_occupancy()[0][1] == PLATE
+        assert sim.hotel_readings()[0].labware_id == PLATE
         before = _plate_in_base(sim)
         long_step = sim.time_step * FREE_MOTION_STEP_RATIO
         assert set(step_lengths(sim, sim.undock())) == {long_step}
@@ -67,6 +67,6 @@ def test_plate_in_the_hotel_rides_a_drive_clamped_at_long_steps_without_slipping
         after = _plate_in_base(sim)
         assert np.linalg.norm(after[:3, 3] - before[:3, 3]) < 0.001
         assert abs(tf.wrap_angle(tf.yaw_of(tf.invert(before) @ after))) < np.radians(0.2)
-        assert sim.hotel_occupancy()[0][1] == PLATE
+        assert sim.hotel_readings()[0].labware_id == PLATE
     finally:
         sim.close()

@@ -17,8 +17,10 @@ import numpy as np
 import pybullet as p
 import pytest
 
+from labware_model.holders import HotelSlot
+from labware_model.labware import Plate
 from tiago_sim import transforms as tf
-from tiago_sim.lab.world import InitialPlate, load_world
+from tiago_sim.lab.world import load_world
 from tiago_sim.physics.simulation import Simulation
 from tiago_sim.robot.kinematics import RobotKinematics
 from tiago_sim.sim_node.base_alignment import compose_planar, head_angles_towards, planar
@@ -37,7 +39,7 @@ def test_a_long_stop_at_the_poi_keeps_the_hotel_off_the_table(forward_error_m):
     navigation error, 10 cm odometry drift over the two drives), then the turn to the station's
     heading."""
     world = load_world()
-    world = dataclasses.replace(world, plates=(InitialPlate(PLATE, "sbs_microplate_96", hotel_slot=1),))
+    world = dataclasses.replace(world, plates={Plate(PLATE, "sbs_microplate_96"): HotelSlot(1)})
     sim = Simulation(world, seed=3)
     try:
         assert sim.run(sim.undock()).success
@@ -53,7 +55,7 @@ def test_a_long_stop_at_the_poi_keeps_the_hotel_off_the_table(forward_error_m):
             closest.append(_closest_to_table(sim, "station_b"))
         assert motion.success
         assert min(closest) > 0.01, f"the robot came {1000 * min(closest):.0f} mm close to the table"
-        assert sim.hotel_occupancy()[0][:2] == (1, PLATE)
+        assert sim.hotel_readings()[0].labware_id == PLATE
     finally:
         sim.close()
 
@@ -88,7 +90,7 @@ def test_planar_poses_compose_like_transforms():
 def test_a_plate_released_off_centre_slides_into_the_hotel_pocket(offset):
     """A plate carried a few mm off centre in the gripper must not stay on a hotel lead-in."""
     world = load_world()
-    world = dataclasses.replace(world, plates=(InitialPlate(PLATE, "sbs_microplate_96", hotel_slot=1),))
+    world = dataclasses.replace(world, plates={Plate(PLATE, "sbs_microplate_96"): HotelSlot(1)})
     sim = Simulation(world, seed=4)
     try:
         T_world_slot = sim.robot.link_pose("hotel_slot_1")
@@ -104,6 +106,6 @@ def test_a_plate_released_off_centre_slides_into_the_hotel_pocket(offset):
             *p.getBasePositionAndOrientation(body, physicsClientId=sim.client_id)
         )
         assert abs(seated[2, 3] - 0.01435 / 2) < 0.001, f"resting {1000 * seated[2, 3]:.1f} mm up"
-        assert sim.hotel_occupancy()[0][:2] == (1, PLATE)
+        assert sim.hotel_readings()[0].labware_id == PLATE
     finally:
         sim.close()

@@ -11,7 +11,8 @@ from typing import TYPE_CHECKING
 
 from sila2.server import MetadataDict
 
-from sila_labware.device.inventory import LabwareRecord, LocationKind
+from labware_model.holders import GRIPPER, UNKNOWN, HotelSlot, Nest, aboard
+from sila_labware.device.inventory import LabwareRecord
 
 from ..generated.labwareinventory import LabwareInventoryBase, LocateLabware_Responses, UnknownLabware
 
@@ -20,14 +21,22 @@ if TYPE_CHECKING:
 
 
 def location_structure(record: LabwareRecord, gripper_slot: int) -> dict[str, object]:
+    """The feature's LabwareLocation: a nest is (Position = station, Index = sub-position); aboard,
+    a hotel slot is (Position = "", Index = slot) and the gripper counts as `gripper_slot`."""
     location = record.location
-    aboard = location.kind in (LocationKind.HOTEL, LocationKind.GRIPPER)
-    index = location.index if location.kind is not LocationKind.GRIPPER else gripper_slot
+    if isinstance(location, Nest):
+        position, index = location.station, location.sub_position
+    elif isinstance(location, HotelSlot):
+        position, index = "", location.index
+    elif location == GRIPPER:
+        position, index = "", gripper_slot
+    else:  # unknown: never published (see LabwareInventoryImpl)
+        position, index = "", 1
     return {
         "LabwareUniqueID": record.labware_id,
         "LabwareType": record.labware_type,
-        "Aboard": aboard,
-        "Position": "" if aboard else location.station,
+        "Aboard": aboard(location),
+        "Position": position,
         "Index": max(1, index),
     }
 
@@ -46,18 +55,14 @@ class LabwareInventoryImpl(LabwareInventoryBase):
     def _publish(self, records: tuple[LabwareRecord, ...]) -> None:
         slot = self._gripper_slot()
         self.update_LabwareLocations(
-            [
-                location_structure(record, slot)
-                for record in records
-                if record.location.kind is not LocationKind.UNKNOWN
-            ]
+            [location_structure(record, slot) for record in records if record.location != UNKNOWN]
         )
 
     def LocateLabware(self, LabwareUniqueID: str, *, metadata: MetadataDict) -> LocateLabware_Responses:
         record = self.robot.inventory.locate(LabwareUniqueID)
         if record is None:
             raise UnknownLabware(f"this robot has not handled labware {LabwareUniqueID!r}")
-        if record.location.kind is LocationKind.UNKNOWN:
+        if record.location == UNKNOWN:
             raise UnknownLabware(
                 f"labware {LabwareUniqueID!r} is lost: after the last failed transfer neither the robot "
                 "nor any station sensor reports it"

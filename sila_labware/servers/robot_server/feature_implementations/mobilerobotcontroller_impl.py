@@ -51,9 +51,13 @@ SILA_ROBOT_STATES = {
 def onboard_items(status: RobotStatus) -> list[dict[str, object]]:
     """OnboardLabware: one entry per occupied hotel slot, in slot order."""
     return [
-        {"InternalPosition": slot.index, "LabwareUniqueID": slot.labware_id, "LabwareType": slot.labware_type}
-        for slot in sorted(status.hotel, key=lambda slot: slot.index)
-        if slot.labware_id
+        {
+            "InternalPosition": reading.slot.index,
+            "LabwareUniqueID": reading.labware_id,
+            "LabwareType": reading.labware_type,
+        }
+        for reading in sorted(status.hotel, key=lambda reading: reading.slot)
+        if reading.labware_id
     ]
 
 
