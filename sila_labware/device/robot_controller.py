@@ -37,12 +37,7 @@ from sila_labware.device.errors import CommandSequenceError, MotionFailed, Trans
 from sila_labware.device.inventory import Inventory
 from sila_labware.device.robot_backend import RobotBackend
 from sila_labware.device.sequences import ManipulatorSequence, PreparedTransfer
-from sila_labware.device.validation import (
-    check_handover,
-    check_intermediate_actions,
-    check_internal_position,
-    check_text,
-)
+from sila_labware.device.validation import DeviceParameters
 
 logger = logging.getLogger(__name__)
 
@@ -83,7 +78,12 @@ class RobotController:
         self.inventory = Inventory()
         self._active_goal: ActionGoal | None = None
         self._active_lock = threading.Lock()
-        self._sub_positions = {station.name: station.sub_positions for station in workcell.stations}
+        self.parameters = DeviceParameters(
+            {station.name: station.sub_positions for station in workcell.stations},
+            workcell.hotel_slots,
+            workcell.pois,
+            INTERMEDIATE_ACTIONS,
+        )
         link.on_robot_status(self.inventory.observe_robot)
         self.inventory.observe_robot(link.robot_status())
 
@@ -109,10 +109,9 @@ class RobotController:
         report: ProgressReport | None = None,
     ) -> None:
         """Robot will receive a plate from `position`: the hotel slot must be free; drive there."""
-        handover = check_handover(position, sub_position, self._sub_positions)
-        check_internal_position(internal_position, self.internal_positions)
-        check_text(labware_type, "LabwareType", allow_empty=True)
-        check_text(labware_id, "LabwareUniqueID", allow_empty=True)
+        handover = self.parameters.prepare(
+            position, sub_position, internal_position, labware_type, labware_id
+        )
         occupant = self._hotel_occupant(self.link.robot_status(), internal_position)
         if occupant is not None:
             raise CommandSequenceError(
@@ -127,8 +126,7 @@ class RobotController:
         self, position: str, sub_position: int, internal_position: int, report: ProgressReport | None = None
     ) -> None:
         """Robot will hand a plate to `position`: the hotel slot must hold one; drive there."""
-        handover = check_handover(position, sub_position, self._sub_positions)
-        check_internal_position(internal_position, self.internal_positions)
+        handover = self.parameters.prepare(position, sub_position, internal_position)
         occupant = self._hotel_occupant(self.link.robot_status(), internal_position)
         if occupant is None:
             raise CommandSequenceError(
@@ -173,8 +171,7 @@ class RobotController:
         """GetLabware or PutLabware: check, match the prepared transfer, run the goal, settle the
         inventory from what the robot observed, then raise TransferFailed if the goal failed."""
         getting = command == "GetLabware"
-        handover = check_handover(position, sub_position, self._sub_positions)
-        check_intermediate_actions(intermediate_actions, INTERMEDIATE_ACTIONS)
+        handover = self.parameters.transfer(position, sub_position, intermediate_actions)
         transfer = self.sequence.begin_get(handover) if getting else self.sequence.begin_put(handover)
         try:
             request = LabwareHandover(
@@ -208,11 +205,7 @@ class RobotController:
         self._await_state_report(lambda status: not status.docked, "undocked")
 
     def drive_to_poi(self, poi: str, report: ProgressReport | None = None) -> None:
-        check_text(poi, "PointOfInterest", allow_empty=False)
-        if poi not in self.workcell.pois:
-            raise MotionFailed(
-                "UNKNOWN_POI", f"no point of interest {poi!r}; known: {', '.join(self.workcell.pois)}"
-            )
+        self.parameters.point_of_interest(poi)
         if self.link.robot_status().docked:
             raise MotionFailed("DOCKED", f"the robot is docked; undock before driving to {poi!r}")
         progress = CommandProgress(report)

@@ -30,7 +30,7 @@ from ros_bridge.errors import BridgeTimeout
 from sila_labware.device.errors import CommandSequenceError
 from sila_labware.device.robot_backend import StationBackend
 from sila_labware.device.sequences import NestExpectation, NestPhase, SiteSequence
-from sila_labware.device.validation import check_handover, check_internal_position, check_text
+from sila_labware.device.validation import DeviceParameters
 
 logger = logging.getLogger(__name__)
 
@@ -47,6 +47,7 @@ class StationController:
         self.station = station
         self.settle_timeout_s = settle_timeout_s
         self.sequence = SiteSequence(station.name, station.sub_positions)
+        self.parameters = DeviceParameters({station.name: station.sub_positions}, STATION_INTERNAL_POSITIONS)
 
     def handover_positions(self) -> list[tuple[str, int]]:
         return [(self.station.name, self.station.sub_positions)]
@@ -58,26 +59,24 @@ class StationController:
     def prepare_for_input(
         self, position: str, sub_position: int, internal_position: int, labware_type: str, labware_id: str
     ) -> None:
-        sub_position = self._check_handover(position, sub_position)
-        check_internal_position(internal_position, self.internal_positions)
-        check_text(labware_type, "LabwareType", allow_empty=True)
-        check_text(labware_id, "LabwareUniqueID", allow_empty=True)
+        sub_position = self.parameters.prepare(
+            position, sub_position, internal_position, labware_type, labware_id
+        ).sub_position
         occupied = self.nest_reading(sub_position).occupied
         self.sequence.prepare_for_input(sub_position, internal_position, labware_type, labware_id, occupied)
 
     def prepare_for_output(self, position: str, sub_position: int, internal_position: int) -> None:
-        sub_position = self._check_handover(position, sub_position)
-        check_internal_position(internal_position, self.internal_positions)
+        sub_position = self.parameters.prepare(position, sub_position, internal_position).sub_position
         occupied = self.nest_reading(sub_position).occupied
         self.sequence.prepare_for_output(sub_position, internal_position, occupied)
 
     def labware_delivered(self, position: str, sub_position: int) -> NestExpectation:
-        sub_position = self._check_handover(position, sub_position)
+        sub_position = self.parameters.handover(position, sub_position).sub_position
         self._require_phase_then_sensor(sub_position, "LabwareDelivered", want_occupied=True)
         return self.sequence.labware_delivered(sub_position)
 
     def labware_removed(self, position: str, sub_position: int) -> NestExpectation:
-        sub_position = self._check_handover(position, sub_position)
+        sub_position = self.parameters.handover(position, sub_position).sub_position
         self._require_phase_then_sensor(sub_position, "LabwareRemoved", want_occupied=False)
         return self.sequence.labware_removed(sub_position)
 
@@ -89,11 +88,6 @@ class StationController:
                 return reading
         logger.warning("no sensor reading for %s; treating it as empty", nest)
         return NestReading(nest, False, "")
-
-    def _check_handover(self, position: str, sub_position: int) -> int:
-        return check_handover(
-            position, sub_position, {self.station.name: self.station.sub_positions}
-        ).sub_position
 
     def _require_phase_then_sensor(self, sub_position: int, command: str, want_occupied: bool) -> None:
         # Order first (a wrong order is reported as such, without waiting for the sensor).

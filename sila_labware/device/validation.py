@@ -11,6 +11,7 @@ them empty (the robot then tracks the plate under the id the robot side reports)
 from __future__ import annotations
 
 from collections.abc import Collection, Mapping, Sequence
+from dataclasses import dataclass, field
 
 from labware_model.holders import Nest
 from sila_labware.device.errors import ParameterError
@@ -74,3 +75,51 @@ def check_intermediate_actions(
                 parameter, f"unknown intermediate action {action!r}; this device offers: {offered}"
             )
     return tuple(actions)
+
+
+@dataclass(frozen=True)
+class DeviceParameters:
+    """What one device offers, and the checks of each command's parameters against it.
+
+    The checks need no motion and no device state, so the SiLA servers also run them on the
+    initiating call of a command (servers.initiation_checks), and each command runs them again.
+    All raise ParameterError naming the parameter."""
+
+    sub_positions: Mapping[str, int]
+    """Hand-over position (station) -> number of its nests."""
+    internal_positions: int
+    points_of_interest: tuple[str, ...] = ()
+    intermediate_actions: tuple[str, ...] = field(default=())
+
+    def handover(self, position: str, sub_position: int) -> Nest:
+        return check_handover(position, sub_position, self.sub_positions)
+
+    def prepare(
+        self,
+        position: str,
+        sub_position: int,
+        internal_position: int,
+        labware_type: str = "",
+        labware_id: str = "",
+    ) -> Nest:
+        """PrepareForInput/PrepareForOutput: a nest this device serves, an internal position it
+        has, labware type and id it can record (either may be empty)."""
+        nest = self.handover(position, sub_position)
+        check_internal_position(internal_position, self.internal_positions)
+        check_text(labware_type, "LabwareType", allow_empty=True)
+        check_text(labware_id, "LabwareUniqueID", allow_empty=True)
+        return nest
+
+    def transfer(self, position: str, sub_position: int, intermediate_actions: Sequence[str]) -> Nest:
+        """GetLabware/PutLabware: a nest this device serves, intermediate actions it offers."""
+        nest = self.handover(position, sub_position)
+        check_intermediate_actions(intermediate_actions, self.intermediate_actions)
+        return nest
+
+    def point_of_interest(self, poi: str) -> str:
+        """DriveToPointOfInterest: a point of interest of this workcell."""
+        check_text(poi, "PointOfInterest", allow_empty=False)
+        if poi not in self.points_of_interest:
+            known = ", ".join(self.points_of_interest) or "none"
+            raise ParameterError("PointOfInterest", f"no point of interest {poi!r}; known: {known}")
+        return poi

@@ -12,6 +12,7 @@ from uuid import UUID, uuid4
 from sila2.server import SilaServer
 
 from sila_labware.device.robot_controller import RobotController
+from sila_labware.servers.initiation_checks import InitiationChecks, check_labware_transfer
 
 from .feature_implementations.labwareinventory_impl import LabwareInventoryImpl
 from .feature_implementations.labwaretransfermanipulatorcontroller_impl import (
@@ -47,6 +48,7 @@ class Server(SilaServer):
             server_uuid=server_uuid if server_uuid is not None else uuid4(),
         )
         self.robot = robot
+        self.initiation_checks = InitiationChecks.install(self)
 
         self.labwareinventory = LabwareInventoryImpl(self)
         self.set_feature_implementation(LabwareInventoryFeature, self.labwareinventory)
@@ -58,3 +60,10 @@ class Server(SilaServer):
 
         self.mobilerobotcontroller = MobileRobotControllerImpl(self)
         self.set_feature_implementation(MobileRobotControllerFeature, self.mobilerobotcontroller)
+
+        check_labware_transfer(
+            self.initiation_checks, LabwareTransferManipulatorControllerFeature, robot.parameters
+        )
+        self.initiation_checks.add(
+            MobileRobotControllerFeature, "DriveToPointOfInterest", robot.parameters.point_of_interest
+        )

@@ -9,6 +9,7 @@ from uuid import UUID, uuid4
 from sila2.server import SilaServer
 
 from sila_labware.device.station_controller import StationController
+from sila_labware.servers.initiation_checks import InitiationChecks, check_labware_transfer
 
 from .feature_implementations.labwaretransfersitecontroller_impl import LabwareTransferSiteControllerImpl
 from .generated.labwaretransfersitecontroller import LabwareTransferSiteControllerFeature
@@ -39,8 +40,12 @@ class Server(SilaServer):
         )
 
         self.station = station
+        self.initiation_checks = InitiationChecks.install(self)
 
         self.labwaretransfersitecontroller = LabwareTransferSiteControllerImpl(self)
         self.set_feature_implementation(
             LabwareTransferSiteControllerFeature, self.labwaretransfersitecontroller
+        )
+        check_labware_transfer(
+            self.initiation_checks, LabwareTransferSiteControllerFeature, station.parameters
         )
