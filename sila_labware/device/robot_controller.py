@@ -9,12 +9,16 @@ feature implementations translate its exceptions into SiLA errors:
 - `TransferFailed` -> LabwareNotPicked / LabwareNotPlaced, with the robot side's message
 - `MotionFailed` -> the MobileRobotController error for its ROS error code
 
+A command can be cancelled by its execution (`cancel_command` with the token it runs under, see
+`cancellation`) or, whatever runs, by `stop_motion`; either ends it with its defined error.
+
 Threads: methods run on SiLA handler threads and block until the ROS goal ends, waiting on
 futures; progress reports are called on the ROS thread (from action feedback).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import threading
 from collections.abc import Callable
@@ -23,7 +27,8 @@ from ros_bridge.actions import ActionGoal, ActionOutcome, GoalProgress
 from ros_bridge.errors import BridgeError, BridgeTimeout
 from ros_bridge.robot_link import LabwareHandover, RobotLink
 from ros_bridge.workcell import RobotStatus, WorkcellDescription
-from sila_labware.device.errors import CommandSequenceError, ParameterError
+from sila_labware.device.cancellation import CancelToken, current_token
+from sila_labware.device.errors import CommandSequenceError, MotionFailed, ParameterError, TransferFailed
 from sila_labware.device.inventory import Inventory, in_hotel
 from sila_labware.device.sequences import ManipulatorSequence, PreparedTransfer
 from sila_labware.device.validation import (
@@ -41,24 +46,6 @@ ProgressReport = Callable[[float, float], None]
 
 INTERMEDIATE_ACTIONS: tuple[str, ...] = ()
 """Fully qualified command identifiers this robot can run between pick and place: none yet."""
-
-
-class TransferFailed(Exception):
-    """GetLabware/PutLabware did not move the plate; `error_code` is the robot side's code."""
-
-    def __init__(self, error_code: str, message: str) -> None:
-        super().__init__(message)
-        self.error_code = error_code
-        self.message = message
-
-
-class MotionFailed(Exception):
-    """A base motion (dock, undock, drive) failed; `error_code` is the robot side's code."""
-
-    def __init__(self, error_code: str, message: str) -> None:
-        super().__init__(message)
-        self.error_code = error_code
-        self.message = message
 
 
 class _ScaledReport:
@@ -83,6 +70,7 @@ class RobotController:
         self.sequence = ManipulatorSequence()
         self.inventory = Inventory()
         self._active_goal: ActionGoal | None = None
+        self._active_token: CancelToken | None = None  # the cancel token of the command that sent it
         self._active_lock = threading.Lock()
         self._sub_positions = {station.name: station.sub_positions for station in workcell.stations}
         link.on_robot_status(self.inventory.observe_robot)
@@ -228,6 +216,17 @@ class RobotController:
         goal.cancel()
         return True
 
+    def cancel_command(self, token: CancelToken, reason: str) -> bool:
+        """Cancel the command running under `token` (see `cancellation`): its running goal now, and
+        any goal it would send next. True if one of its goals was running."""
+        token.cancel(reason)
+        with self._active_lock:
+            goal = self._active_goal if self._active_token is token else None
+        if goal is None or goal.outcome.done():
+            return False
+        goal.cancel()
+        return True
+
     def abort_active_goal(self, reason: str) -> bool:
         """End the waiting command now with a failed outcome (the robot side is gone and will not
         answer); True if one was waiting. The command then settles the inventory and raises its
@@ -297,16 +296,24 @@ class RobotController:
         """Send the goal and return its outcome; bridge trouble (no answer, rejection, timeout, even
         while sending) becomes a failed outcome, so that callers always settle the inventory and
         raise their own defined error."""
+        token = current_token()
+        if token is not None and token.cancelled:
+            return ActionOutcome(False, "CANCELED", f"{token.reason}; {what} was not started", "CANCELED")
         try:
             goal = send()
         except BridgeError as error:
             return ActionOutcome(False, type(error).__name__, f"{what} could not be sent: {error}", "")
         with self._active_lock:
-            self._active_goal = goal
+            self._active_goal, self._active_token = goal, token
         try:
+            if token is not None and token.cancelled:  # cancelled while the goal was being sent
+                goal.cancel()
             goal.wait_accepted(timeout_s=30.0)
             try:
-                return goal.result(self.step_timeout_s)
+                outcome = goal.result(self.step_timeout_s)
+                if token is not None and token.cancelled and not outcome.success:
+                    outcome = dataclasses.replace(outcome, message=f"{token.reason}; {outcome.message}")
+                return outcome
             except BridgeTimeout:
                 logger.warning("%s took longer than %.0f s: cancelling it", what, self.step_timeout_s)
                 goal.cancel()
@@ -320,7 +327,7 @@ class RobotController:
             return ActionOutcome(False, type(error).__name__, str(error), "")
         finally:
             with self._active_lock:
-                self._active_goal = None
+                self._active_goal, self._active_token = None, None
 
     def _settle(
         self, labware_id: str, transfer: PreparedTransfer, outcome: ActionOutcome, expect_aboard: bool

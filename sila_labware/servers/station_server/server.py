@@ -1,6 +1,7 @@
 # Created by sila2.code_generator 0.14.0 (new-package); hand-maintained since: regeneration never touches it.
 
-"""One station's SiLA server: the standard's passive-side feature, backed by a `StationController`."""
+"""One station's SiLA server: the standard's passive-side feature, backed by a `StationController`,
+and the SiLA core features LockController and SimulationController."""
 
 from __future__ import annotations
 
@@ -9,9 +10,12 @@ from uuid import UUID, uuid4
 from sila2.server import SilaServer
 
 from sila_labware.device.station_controller import StationController
+from sila_labware.servers.locking import serve_lock_controller
 
 from .feature_implementations.labwaretransfersitecontroller_impl import LabwareTransferSiteControllerImpl
+from .feature_implementations.simulationcontroller_impl import SimulationControllerImpl
 from .generated.labwaretransfersitecontroller import LabwareTransferSiteControllerFeature
+from .generated.simulationcontroller import SimulationControllerFeature
 
 
 class Server(SilaServer):
@@ -39,8 +43,12 @@ class Server(SilaServer):
         )
 
         self.station = station
+        self.lockcontroller = serve_lock_controller(self)
 
         self.labwaretransfersitecontroller = LabwareTransferSiteControllerImpl(self)
         self.set_feature_implementation(
             LabwareTransferSiteControllerFeature, self.labwaretransfersitecontroller
         )
+
+        self.simulationcontroller = SimulationControllerImpl(self)
+        self.set_feature_implementation(SimulationControllerFeature, self.simulationcontroller)

@@ -1,11 +1,11 @@
-"""Cancelling a running GetLabware from a SiLA client.
+"""Cancelling a running GetLabware from a SiLA client with the robot's own StopMotion.
 
-How a client cancels here: sila2 0.14 ships no CancelController (the SiLA core feature is not in
-its `sila2.features`, and its servers have no hook to interrupt a running command instance), so
-the robot's own unobservable command MobileRobotController.StopMotion is the cancel: it cancels
-whatever ROS goal the robot runs, GetLabware's included. The sequencer stops the running
-sub-action safely and reports CANCELED; GetLabware then ends with its defined error
-LabwareNotPicked naming the cancel, after the inventory was settled from the robot's observations.
+Two ways to cancel: a generic client uses the SiLA core feature CancelController (by execution
+UUID; see test_sila_core_features.py); a client of our MobileRobotController can also call its
+unobservable StopMotion, tested here: it cancels whatever ROS goal the robot runs, GetLabware's
+included. The sequencer stops the running sub-action safely and reports CANCELED; GetLabware then
+ends with its defined error LabwareNotPicked naming the cancel, after the inventory was settled
+from the robot's observations.
 
 Consistency is checked against physics ground truth (the simulation's CheckPlacement), and a
 complete transfer must then succeed from wherever the plate is.
