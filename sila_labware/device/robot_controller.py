@@ -14,6 +14,9 @@ Progress: each command reports through one `CommandProgress` (ros_bridge.progres
 each of its goals into a share of the command (undock 0..0.2, then drive 0.2..1) and never lets
 the reported fraction go down.
 
+A command can be cancelled by its execution (`cancel_command` with the token it runs under, see
+`cancellation`) or, whatever runs, by `stop_motion`; either ends it with its defined error.
+
 Threads: methods run on SiLA handler threads and block until the goal ends, waiting on the goal's
 status; progress reports are called on the back end's answering thread (the ROS thread) from goal
 feedback, and on the handler thread at the end of a command. `stop_motion` and
@@ -22,6 +25,7 @@ feedback, and on the handler thread at the end of a command. `stop_motion` and
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import threading
 from collections.abc import Callable
@@ -33,6 +37,7 @@ from ros_bridge.errors import BridgeError, BridgeTimeout
 from ros_bridge.goal_status import ActionGoal, ActionOutcome
 from ros_bridge.progress import CommandProgress, ProgressReport
 from ros_bridge.workcell import LabwareHandover, RobotStatus
+from sila_labware.device.cancellation import CancelToken, current_token
 from sila_labware.device.errors import CommandSequenceError, MotionFailed, TransferFailed
 from sila_labware.device.inventory import Inventory
 from sila_labware.device.robot_backend import RobotBackend
@@ -77,6 +82,7 @@ class RobotController:
         self.sequence = ManipulatorSequence()
         self.inventory = Inventory()
         self._active_goal: ActionGoal | None = None
+        self._active_token: CancelToken | None = None  # the cancel token of the command that sent it
         self._active_lock = threading.Lock()
         self.parameters = DeviceParameters(
             {station.name: station.sub_positions for station in workcell.stations},
@@ -223,6 +229,17 @@ class RobotController:
         goal.cancel()
         return True
 
+    def cancel_command(self, token: CancelToken, reason: str) -> bool:
+        """Cancel the command running under `token` (see `cancellation`): its running goal now, and
+        any goal it would send next. True if one of its goals was running."""
+        token.cancel(reason)
+        with self._active_lock:
+            goal = self._active_goal if self._active_token is token else None
+        if goal is None or goal.done:
+            return False
+        goal.cancel()
+        return True
+
     def abort_active_goal(self, reason: str) -> bool:
         """End the waiting command now (the robot side is gone and will not answer): its goal ends
         with GoalAbandoned(`reason`); True if a goal was still running. The command then settles
@@ -285,17 +302,26 @@ class RobotController:
     def _wait(self, send: Callable[[], ActionGoal], what: str) -> ActionOutcome:
         """Send the goal and return its outcome; back-end trouble (no answer, rejection, timeout, an
         abandoned goal, even while sending) becomes a failed outcome whose error code names the
-        bridge error, so that callers always settle the inventory and raise their own defined error."""
+        bridge error, so that callers always settle the inventory and raise their own defined error.
+        A command cancelled through its token sends no further goal."""
+        token = current_token()
+        if token is not None and token.cancelled:
+            return ActionOutcome(False, "CANCELED", f"{token.reason}; {what} was not started", "CANCELED")
         try:
             goal = send()
         except BridgeError as error:
             return ActionOutcome(False, type(error).__name__, f"{what} could not be sent: {error}", "")
         with self._active_lock:
-            self._active_goal = goal
+            self._active_goal, self._active_token = goal, token
         try:
+            if token is not None and token.cancelled:  # cancelled while the goal was being sent
+                goal.cancel()
             goal.wait_accepted(self.waits.accept_s)
             try:
-                return goal.result(self.step_timeout_s)
+                outcome = goal.result(self.step_timeout_s)
+                if token is not None and token.cancelled and not outcome.success:
+                    outcome = dataclasses.replace(outcome, message=f"{token.reason}; {outcome.message}")
+                return outcome
             except BridgeTimeout:
                 logger.warning("%s took longer than %.0f s: cancelling it", what, self.step_timeout_s)
                 goal.cancel()
@@ -309,7 +335,7 @@ class RobotController:
             return ActionOutcome(False, type(error).__name__, str(error), "")
         finally:
             with self._active_lock:
-                self._active_goal = None
+                self._active_goal, self._active_token = None, None
 
     def _settle(
         self, labware_id: str, transfer: PreparedTransfer, outcome: ActionOutcome, expect_aboard: bool

@@ -34,8 +34,10 @@ SERVER_FEATURES: dict[str, tuple[str, ...]] = {
         "LabwareTransferManipulatorController.sila.xml",
         "MobileRobotController.sila.xml",
         "LabwareInventory.sila.xml",
+        "CancelController.sila.xml",
+        "SimulationController.sila.xml",
     ),
-    "station_server": ("LabwareTransferSiteController.sila.xml",),
+    "station_server": ("LabwareTransferSiteController.sila.xml", "SimulationController.sila.xml"),
 }
 
 # Written by Python or the tools while the tree is used; never part of the generated content.

@@ -10,11 +10,8 @@ motion and no robot state, so they can answer at once.
 How: a gRPC server interceptor in front of the initiation RPC of each checked command. It
 unpacks the parameters as sila2 does (`Command.parameters.to_native_type`), calls the device's
 check with them, and answers a `ParameterError` with a SiLA validation error naming the
-parameter; otherwise the call goes on to sila2 unchanged. The interceptor has to be on the gRPC
-server from its creation, and sila2 creates that server in `SilaServer.__init__` without a way to
-pass one: `install` replaces it with one that has the interceptor, right after
-`SilaServer.__init__` and before any feature of ours is added, and moves the SiLAService servicer
-(the only one registered by then) over to it.
+parameter; otherwise the call goes on to sila2 unchanged. `grpc_interceptors` puts it in front
+of the server.
 
 Threads: checks run on gRPC's handler threads, concurrently; they must be pure (no robot state).
 """
@@ -24,13 +21,11 @@ from __future__ import annotations
 import logging
 import threading
 from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import grpc
 from sila2.framework import Feature, ValidationError
 from sila2.framework.utils import raise_as_rpc_error
-from sila2.server import SilaServer
 
 from sila_labware.device.errors import ParameterError
 from sila_labware.device.validation import DeviceParameters
@@ -43,8 +38,6 @@ CommandCheck = Callable[..., None]
 """Called with the command's parameters in their native types, in the order the feature defines
 them; raises ParameterError naming the parameter for a value this device refuses."""
 
-GRPC_WORKERS = 100  # sila2's default for the server it creates
-
 
 class InitiationChecks(grpc.ServerInterceptor):
     """The checks of one server, by feature and command (see the module docstring)."""
@@ -52,24 +45,6 @@ class InitiationChecks(grpc.ServerInterceptor):
     def __init__(self) -> None:
         self._lock = threading.Lock()
         self._checks: dict[str, tuple[Feature, str, CommandCheck]] = {}
-
-    @classmethod
-    def install(cls, server: SilaServer) -> InitiationChecks:
-        """Give `server` a gRPC server with the checks in front; call right after
-        `SilaServer.__init__`, before `set_feature_implementation`."""
-        if set(server.feature_servicers) != {"SiLAService"}:
-            raise RuntimeError("install the initiation checks before adding features")
-        checks = cls()
-        server.grpc_server = grpc.server(
-            ThreadPoolExecutor(
-                max_workers=GRPC_WORKERS, thread_name_prefix=f"grpc-executor-{server.server_uuid}"
-            ),
-            interceptors=[checks],
-        )
-        silaservice = server.feature_servicers["SiLAService"]
-        add_servicer = silaservice.feature._grpc_module.add_SiLAServiceServicer_to_server
-        add_servicer(silaservice, server.grpc_server)
-        return checks
 
     def add(self, feature: Feature, command: str, check: CommandCheck) -> None:
         """Run `check` on every initiation of `feature`'s observable command `command`."""

@@ -13,6 +13,7 @@ from typing import Any
 
 from sila2.client import SilaClient
 
+from labware_model.holders import GRIPPER, HotelSlot, Location, Nest
 from sila_labware.deployment.stack import Deployment
 from tests.helpers.sila_stack import client_for
 
@@ -112,3 +113,18 @@ class Cell:
             (reading.nest.station, reading.nest.sub_position): reading.occupied
             for reading in self.deployment.link.nest_readings()
         }
+
+    def physical_location(self, plate: str) -> Location:
+        """Where the simulation says the plate is: a nest, a hotel slot, the gripper, the floor
+        (ground truth, for checks only)."""
+        assert self.deployment.link is not None
+        return self.deployment.link.check_placement(plate).location
+
+    def reported_location(self, plate: str) -> Location:
+        """Where the robot server's inventory says the plate is, read from its SiLA properties."""
+        aboard, station, index = self.location(plate)
+        if not aboard:
+            return Nest(station, index)
+        onboard = self.robot.MobileRobotController.OnboardLabware.get()
+        slots = [item.InternalPosition for item in onboard if item.LabwareUniqueID == plate]
+        return HotelSlot(slots[0]) if slots else GRIPPER

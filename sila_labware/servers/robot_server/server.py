@@ -1,8 +1,10 @@
 # Created by sila2.code_generator 0.14.0 (new-package); hand-maintained since: regeneration never touches it.
-"""The robot's SiLA server: the standard manipulator feature plus our motion and inventory features.
+"""The robot's SiLA server: the standard manipulator feature plus our motion and inventory features,
+and the SiLA core features CancelController, LockController and SimulationController.
 
 It is handed a `RobotController` (built on a running ROS bridge); the feature implementations
-take their behaviour from it.
+take their behaviour from it. `cancellable_commands` tracks the running robot commands for
+CancelController; `serve_lock_controller` adds LockController with its gRPC guard.
 """
 
 from __future__ import annotations
@@ -12,16 +14,23 @@ from uuid import UUID, uuid4
 from sila2.server import SilaServer
 
 from sila_labware.device.robot_controller import RobotController
+from sila_labware.servers.grpc_interceptors import serve_with_interceptors
 from sila_labware.servers.initiation_checks import InitiationChecks, check_labware_transfer
+from sila_labware.servers.locking import serve_lock_controller
 
+from .cancellable_commands import CancellableCommands
+from .feature_implementations.cancelcontroller_impl import CancelControllerImpl
 from .feature_implementations.labwareinventory_impl import LabwareInventoryImpl
 from .feature_implementations.labwaretransfermanipulatorcontroller_impl import (
     LabwareTransferManipulatorControllerImpl,
 )
 from .feature_implementations.mobilerobotcontroller_impl import MobileRobotControllerImpl
+from .feature_implementations.simulationcontroller_impl import SimulationControllerImpl
+from .generated.cancelcontroller import CancelControllerFeature
 from .generated.labwareinventory import LabwareInventoryFeature
 from .generated.labwaretransfermanipulatorcontroller import LabwareTransferManipulatorControllerFeature
 from .generated.mobilerobotcontroller import MobileRobotControllerFeature
+from .generated.simulationcontroller import SimulationControllerFeature
 
 
 class Server(SilaServer):
@@ -48,7 +57,8 @@ class Server(SilaServer):
             server_uuid=server_uuid if server_uuid is not None else uuid4(),
         )
         self.robot = robot
-        self.initiation_checks = InitiationChecks.install(self)
+        self.cancellable_commands = CancellableCommands(self, robot)
+        self.lockcontroller, lock_guard = serve_lock_controller(self)
 
         self.labwareinventory = LabwareInventoryImpl(self)
         self.set_feature_implementation(LabwareInventoryFeature, self.labwareinventory)
@@ -61,9 +71,18 @@ class Server(SilaServer):
         self.mobilerobotcontroller = MobileRobotControllerImpl(self)
         self.set_feature_implementation(MobileRobotControllerFeature, self.mobilerobotcontroller)
 
+        self.cancelcontroller = CancelControllerImpl(self)
+        self.set_feature_implementation(CancelControllerFeature, self.cancelcontroller)
+
+        self.simulationcontroller = SimulationControllerImpl(self)
+        self.set_feature_implementation(SimulationControllerFeature, self.simulationcontroller)
+
+        # answers that must come before sila2 handles a call: a wrong lock token, a bad parameter
+        initiation_checks = InitiationChecks()
         check_labware_transfer(
-            self.initiation_checks, LabwareTransferManipulatorControllerFeature, robot.parameters
+            initiation_checks, LabwareTransferManipulatorControllerFeature, robot.parameters
         )
-        self.initiation_checks.add(
+        initiation_checks.add(
             MobileRobotControllerFeature, "DriveToPointOfInterest", robot.parameters.point_of_interest
         )
+        serve_with_interceptors(self, [lock_guard, initiation_checks])

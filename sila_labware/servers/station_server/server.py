@@ -1,6 +1,7 @@
 # Created by sila2.code_generator 0.14.0 (new-package); hand-maintained since: regeneration never touches it.
 
-"""One station's SiLA server: the standard's passive-side feature, backed by a `StationController`."""
+"""One station's SiLA server: the standard's passive-side feature, backed by a `StationController`,
+and the SiLA core features LockController and SimulationController."""
 
 from __future__ import annotations
 
@@ -9,10 +10,14 @@ from uuid import UUID, uuid4
 from sila2.server import SilaServer
 
 from sila_labware.device.station_controller import StationController
+from sila_labware.servers.grpc_interceptors import serve_with_interceptors
 from sila_labware.servers.initiation_checks import InitiationChecks, check_labware_transfer
+from sila_labware.servers.locking import serve_lock_controller
 
 from .feature_implementations.labwaretransfersitecontroller_impl import LabwareTransferSiteControllerImpl
+from .feature_implementations.simulationcontroller_impl import SimulationControllerImpl
 from .generated.labwaretransfersitecontroller import LabwareTransferSiteControllerFeature
+from .generated.simulationcontroller import SimulationControllerFeature
 
 
 class Server(SilaServer):
@@ -40,12 +45,17 @@ class Server(SilaServer):
         )
 
         self.station = station
-        self.initiation_checks = InitiationChecks.install(self)
+        self.lockcontroller, lock_guard = serve_lock_controller(self)
 
         self.labwaretransfersitecontroller = LabwareTransferSiteControllerImpl(self)
         self.set_feature_implementation(
             LabwareTransferSiteControllerFeature, self.labwaretransfersitecontroller
         )
-        check_labware_transfer(
-            self.initiation_checks, LabwareTransferSiteControllerFeature, station.parameters
-        )
+
+        self.simulationcontroller = SimulationControllerImpl(self)
+        self.set_feature_implementation(SimulationControllerFeature, self.simulationcontroller)
+
+        # answers that must come before sila2 handles a call: a wrong lock token, a bad parameter
+        initiation_checks = InitiationChecks()
+        check_labware_transfer(initiation_checks, LabwareTransferSiteControllerFeature, station.parameters)
+        serve_with_interceptors(self, [lock_guard, initiation_checks])

@@ -1,6 +1,7 @@
 """Two SiLA clients (separate SilaClient objects, separate channels) command one robot at once.
 
-Policy under test: refuse by sequence, no LockController. The robot runs one thing at a time
+Policy under test: refuse by sequence, for clients that do not lock the robot (LockController,
+when a client uses it, refuses the other clients' calls outright). The robot runs one thing at a time
 (`ManipulatorSequence`); a command arriving while a motion or transfer runs, or while another
 client's preparation is pending, gets a defined error that says what the robot is busy with:
 RobotBusy for MobileRobotController motions, InvalidCommandSequence for the labware-transfer

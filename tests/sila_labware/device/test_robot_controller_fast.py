@@ -163,11 +163,10 @@ def test_driving_while_docked_or_to_an_unknown_poi_is_refused() -> None:
     with pytest.raises(MotionFailed) as docked:
         controller.drive_to_poi("rack_poi")
     assert docked.value.error_code == "DOCKED"
-    with pytest.raises(MotionFailed) as unknown:
+    with pytest.raises(ParameterError) as unknown:
         controller.drive_to_poi("attic")
-    assert (
-        unknown.value.error_code == "UNKNOWN_POI" and "known: reader_poi, rack_poi" in unknown.value.message
-    )
+    assert unknown.value.parameter == "PointOfInterest"
+    assert "known: reader_poi, rack_poi" in unknown.value.message
     assert fake.sent == []
 
 

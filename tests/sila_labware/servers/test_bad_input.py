@@ -298,11 +298,10 @@ def test_drive_refuses_unknown_points_and_any_point_while_docked(unchanged: Cell
         "MobileRobot.DriveToPointOfInterest",
         observable(lambda: unchanged.robot.MobileRobotController.DriveToPointOfInterest(PointOfInterest=poi)),
     )
-    if not poi or not text_ok(poi):
-        assert kind == "validation"
+    if not poi or not text_ok(poi) or poi not in POINTS_OF_INTEREST:
+        assert kind == "validation"  # an unknown point of interest is refused at initiation
     else:
-        known = poi in POINTS_OF_INTEREST
-        assert kind == ("defined:RobotDocked" if known else "defined:UnknownPointOfInterest")
+        assert kind == "defined:RobotDocked"
     still_answering(unchanged)
 
 

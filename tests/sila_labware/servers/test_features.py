@@ -4,6 +4,9 @@ Why: a scheduler written against the SiLA labware transfer standard must talk to
 That holds only if the gRPC interface generated from our definition is the same as the one generated
 from the standard's own definition (shipped in the unitelabs-cdk wheel), and if identifiers, order,
 errors and constraints (which the proto does not carry) agree too. Descriptions are ours and may differ.
+The same holds for the SiLA core features we define ourselves: SimulationController (compared with the
+file in unitelabs-cdk) and CancelController (no library ships it: compared with the standard's
+elements, written out below from the SiLA base repository's definition).
 """
 
 from __future__ import annotations
@@ -15,6 +18,7 @@ from pathlib import Path
 
 import pytest
 import sila2.resources
+import unitelabs.cdk.features.core.simulation_controller as standard_simulation
 import unitelabs.cdk.features.robot.labware_transfer_manipulator_controller as standard_manipulator
 from google.protobuf import descriptor_pb2, text_format
 from grpc_tools import protoc
@@ -31,6 +35,9 @@ STANDARD_MANIPULATOR_PROTO = STANDARD_DIR / "LabwareTransferManipulatorControlle
 OUR_MANIPULATOR_FDL = FEATURES_DIR / "LabwareTransferManipulatorController.sila.xml"
 OUR_SITE_FDL = FEATURES_DIR / "LabwareTransferSiteController.sila.xml"
 OWN_FEATURES = ("MobileRobotController.sila.xml", "LabwareInventory.sila.xml")
+OUR_CANCEL_FDL = FEATURES_DIR / "CancelController.sila.xml"
+OUR_SIMULATION_FDL = FEATURES_DIR / "SimulationController.sila.xml"
+STANDARD_SIMULATION_FDL = Path(standard_simulation.__file__).parent / "SimulationController-v1_0.sila.xml"
 SILA_NS = "http://www.sila-standard.org"
 NS = {"sila": SILA_NS}
 
@@ -181,9 +188,10 @@ def descriptor_differences(
 # ---------------------------------------------------------------------------------------------------------
 
 
-def test_features_directory_holds_the_four_definitions() -> None:
+def test_features_directory_holds_the_six_definitions() -> None:
     names = sorted(path.name for path in FEATURES_DIR.glob("*.sila.xml"))
-    assert names == sorted([OUR_MANIPULATOR_FDL.name, OUR_SITE_FDL.name, *OWN_FEATURES]), (
+    expected = [OUR_MANIPULATOR_FDL, OUR_SITE_FDL, OUR_CANCEL_FDL, OUR_SIMULATION_FDL]
+    assert names == sorted([*(path.name for path in expected), *OWN_FEATURES]), (
         f"unexpected feature files: {names}"
     )
 
@@ -233,11 +241,12 @@ def test_manipulator_skeleton_equals_the_standard() -> None:
     assert skeleton_diff(fdl_skeleton(STANDARD_MANIPULATOR_FDL), fdl_skeleton(OUR_MANIPULATOR_FDL)) == []
 
 
-def test_manipulator_descriptions_are_our_own() -> None:
-    def descriptions(path: Path) -> set[str]:
-        root = etree.parse(str(path)).getroot()
-        return {" ".join(node.text.split()) for node in root.iter(f"{{{SILA_NS}}}Description")}
+def descriptions(path: Path) -> set[str]:
+    root = etree.parse(str(path)).getroot()
+    return {" ".join(node.text.split()) for node in root.iter(f"{{{SILA_NS}}}Description")}
 
+
+def test_manipulator_descriptions_are_our_own() -> None:
     assert descriptions(STANDARD_MANIPULATOR_FDL).isdisjoint(descriptions(OUR_MANIPULATOR_FDL))
 
 
@@ -505,3 +514,90 @@ def test_sila2_rejects_out_of_bounds_strings_as_validation_errors(
     assert str(raised.value.parameter_fully_qualified_identifier).endswith(
         "MobileRobotController/v1/Command/DriveToPointOfInterest/Parameter/PointOfInterest"
     )
+
+
+# ---------------------------------------------------------------------------------------------------------
+# SiLA core features we define ourselves: SimulationController and CancelController
+# ---------------------------------------------------------------------------------------------------------
+
+
+def test_simulation_controller_equals_the_standard_but_for_descriptions(tmp_path: Path) -> None:
+    assert skeleton_diff(fdl_skeleton(STANDARD_SIMULATION_FDL), fdl_skeleton(OUR_SIMULATION_FDL)) == []
+    standard = proto_from_fdl(STANDARD_SIMULATION_FDL, tmp_path / "standard")
+    ours = proto_from_fdl(OUR_SIMULATION_FDL, tmp_path / "ours")
+    assert descriptor_differences(standard, ours) == []
+    assert descriptions(STANDARD_SIMULATION_FDL).isdisjoint(descriptions(OUR_SIMULATION_FDL))
+    feature = Feature(str(OUR_SIMULATION_FDL))
+    assert str(feature.fully_qualified_identifier) == "org.silastandard/core/SimulationController/v1"
+
+
+UUID_PATTERN = r"[0-9a-f]{8}\-[0-9a-f]{4}\-[0-9a-f]{4}\-[0-9a-f]{4}\-[0-9a-f]{12}"
+STANDARD_CANCEL_CONTROLLER = [
+    # The standard's CancelController v1.0 (sila_base, feature_definitions/org/silastandard/core/
+    # commands/CancelController.sila.xml) as skeleton lines: everything but descriptions and display
+    # names, in the order of the schema (commands before errors).
+    "/Feature[CancelController] [Category=core.commands FeatureVersion=1.0 MaturityLevel=Verified "
+    "Originator=org.silastandard SiLA2Version=1.0] ''",
+    "/Feature[CancelController]/Identifier [] 'CancelController'",
+    "/Feature[CancelController]/Command[CancelCommand] [] ''",
+    "/Feature[CancelController]/Command[CancelCommand]/Identifier [] 'CancelCommand'",
+    "/Feature[CancelController]/Command[CancelCommand]/Observable [] 'No'",
+    "/Feature[CancelController]/Command[CancelCommand]/Parameter[CommandExecutionUUID] [] ''",
+    "/Feature[CancelController]/Command[CancelCommand]/Parameter[CommandExecutionUUID]/Identifier [] "
+    "'CommandExecutionUUID'",
+    *(
+        f"/Feature[CancelController]/Command[CancelCommand]/Parameter[CommandExecutionUUID]/DataType{line}"
+        for line in (
+            " [] ''",
+            "/Constrained [] ''",
+            "/Constrained/DataType [] ''",
+            "/Constrained/DataType/Basic [] 'String'",
+            "/Constrained/Constraints [] ''",
+            "/Constrained/Constraints/Length [] '36'",
+            f"/Constrained/Constraints/Pattern [] {UUID_PATTERN!r}",
+        )
+    ),
+    "/Feature[CancelController]/Command[CancelCommand]/DefinedExecutionErrors [] ''",
+    "/Feature[CancelController]/Command[CancelCommand]/DefinedExecutionErrors/Identifier [] "
+    "'InvalidCommandExecutionUUID'",
+    "/Feature[CancelController]/Command[CancelCommand]/DefinedExecutionErrors/Identifier [] "
+    "'OperationNotSupported'",
+    "/Feature[CancelController]/Command[CancelAll] [] ''",
+    "/Feature[CancelController]/Command[CancelAll]/Identifier [] 'CancelAll'",
+    "/Feature[CancelController]/Command[CancelAll]/Observable [] 'No'",
+    "/Feature[CancelController]/DefinedExecutionError[InvalidCommandExecutionUUID] [] ''",
+    "/Feature[CancelController]/DefinedExecutionError[InvalidCommandExecutionUUID]/Identifier [] "
+    "'InvalidCommandExecutionUUID'",
+    "/Feature[CancelController]/DefinedExecutionError[OperationNotSupported] [] ''",
+    "/Feature[CancelController]/DefinedExecutionError[OperationNotSupported]/Identifier [] "
+    "'OperationNotSupported'",
+]
+
+
+def test_cancel_controller_has_the_standard_identifiers_types_constraints_and_errors() -> None:
+    ours = [line for line in fdl_skeleton(OUR_CANCEL_FDL) if "/DisplayName [" not in line]
+    assert skeleton_diff(STANDARD_CANCEL_CONTROLLER, ours) == []
+    feature = Feature(str(OUR_CANCEL_FDL))
+    assert str(feature.fully_qualified_identifier) == "org.silastandard/core.commands/CancelController/v1"
+
+
+@pytest.mark.parametrize(
+    ("execution_uuid", "accepted"),
+    [
+        ("0b3ed2c6-7a1e-4a51-9b43-2f3c1d7e8a90", True),
+        ("0B3ED2C6-7A1E-4A51-9B43-2F3C1D7E8A90", False),  # the standard's pattern: lower case only
+        ("0b3ed2c6-7a1e-4a51-9b43-2f3c1d7e8a9", False),  # 35 characters
+        ("0b3ed2c6x7a1ex4a51x9b43x2f3c1d7e8a90", False),  # 36 characters, no hyphens
+    ],
+    ids=["lower case", "upper case", "too short", "no hyphens"],
+)
+def test_cancel_command_accepts_only_lower_case_uuid_strings(execution_uuid: str, accepted: bool) -> None:
+    """sila2 enforces the standard's constraints before our implementation sees the UUID."""
+    parameters = Feature(str(OUR_CANCEL_FDL))._unobservable_commands["CancelCommand"].parameters
+    request = parameters.to_message("0b3ed2c6-7a1e-4a51-9b43-2f3c1d7e8a90")
+    request.CommandExecutionUUID.value = execution_uuid
+    if accepted:
+        assert parameters.to_native_type(request).CommandExecutionUUID == execution_uuid
+        return
+    with pytest.raises(ValidationError, match="Constraint violated"):
+        parameters.to_native_type(request)

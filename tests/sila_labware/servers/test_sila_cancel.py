@@ -1,11 +1,11 @@
-"""Cancelling a running GetLabware from a SiLA client.
+"""Cancelling a running GetLabware from a SiLA client with the robot's own StopMotion.
 
-How a client cancels here: sila2 0.14 ships no CancelController (the SiLA core feature is not in
-its `sila2.features`, and its servers have no hook to interrupt a running command instance), so
-the robot's own unobservable command MobileRobotController.StopMotion is the cancel: it cancels
-whatever ROS goal the robot runs, GetLabware's included. The sequencer stops the running
-sub-action safely and reports CANCELED; GetLabware then ends with its defined error
-LabwareNotPicked naming the cancel, after the inventory was settled from the robot's observations.
+Two ways to cancel: a generic client uses the SiLA core feature CancelController (by execution
+UUID; see test_sila_core_features.py); a client of our MobileRobotController can also call its
+unobservable StopMotion, tested here: it cancels whatever ROS goal the robot runs, GetLabware's
+included. The sequencer stops the running sub-action safely and reports CANCELED; GetLabware then
+ends with its defined error LabwareNotPicked naming the cancel, after the inventory was settled
+from the robot's observations.
 
 Consistency is checked against physics ground truth (the simulation's CheckPlacement), and a
 complete transfer must then succeed from wherever the plate is.
@@ -20,7 +20,7 @@ from typing import Any
 import pytest
 from sila2.framework import DefinedExecutionError
 
-from labware_model.holders import GRIPPER, HotelSlot, Location, Nest
+from labware_model.holders import GRIPPER, HotelSlot, Nest
 from tests.helpers.sila_stack import start_stack
 from tests.helpers.sim_parameters import set_node_parameter
 from tests.helpers.transfer_steps import Cell, finish, wait_for_progress
@@ -36,22 +36,6 @@ def cell(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Cell]:
     deployment = start_stack(tmp_path_factory.mktemp("cancel"), insecure=True)
     yield Cell(deployment)
     deployment.stop()
-
-
-def physical_location(cell: Cell) -> Location:
-    """Where the simulation says the plate is: a nest, a hotel slot, the gripper, the floor."""
-    assert cell.deployment.link is not None
-    return cell.deployment.link.check_placement(PLATE).location
-
-
-def reported_location(cell: Cell) -> Location:
-    """Where the robot server's inventory says the plate is, read from its SiLA properties."""
-    aboard, station, index = cell.location(PLATE)
-    if not aboard:
-        return Nest(station, index)
-    onboard = cell.robot.MobileRobotController.OnboardLabware.get()
-    slots = [item.InternalPosition for item in onboard if item.LabwareUniqueID == PLATE]
-    return HotelSlot(slots[0]) if slots else GRIPPER
 
 
 def cancel_mid_way(cell: Cell, get: Any) -> float:
@@ -91,9 +75,9 @@ def test_stop_motion_cancels_get_labware_and_everything_stays_consistent(cell: C
     cell.robot.MobileRobotController.StopMotion()
 
     # Inventory matches physics: the plate is in the source nest, in the hotel or held.
-    where = physical_location(cell)
+    where = cell.physical_location(PLATE)
     assert where in {Nest(*A1), HotelSlot(1), GRIPPER}, where
-    assert reported_location(cell) == where
+    assert cell.reported_location(PLATE) == where
     occupied = cell.nest_occupied()
     assert occupied[A1] == (where == Nest(*A1))
     assert not occupied[B1]
@@ -104,7 +88,7 @@ def test_stop_motion_cancels_get_labware_and_everything_stays_consistent(cell: C
     cell.prepare_pick(A1, PLATE, station_too=False)
     cell.pick(A1)
     cell.place(B1, PLATE)
-    assert physical_location(cell) == Nest(*B1)
-    assert reported_location(cell) == Nest(*B1)
+    assert cell.physical_location(PLATE) == Nest(*B1)
+    assert cell.reported_location(PLATE) == Nest(*B1)
     assert cell.deployment.link is not None
     assert cell.deployment.link.check_placement(PLATE, Nest(*B1)).in_nest

@@ -1,8 +1,9 @@
 """LabwareTransferManipulatorController (SiLA labware transfer v1.0, active side) for the robot.
 
 Behaviour lives in `sila_labware.device.robot_controller.RobotController`; this file only translates:
-parameters in, progress out, exceptions into the standard's errors. Handler threads block on
-the robot's ROS goals (futures with timeouts), never on the ROS executor.
+parameters in, progress out, exceptions into the standard's errors. Every command runs under its
+execution's cancel token (`cancellable_commands`), so CancelController can stop it. Handler threads
+block on the robot's ROS goals (futures with timeouts), never on the ROS executor.
 """
 
 from __future__ import annotations
@@ -48,6 +49,7 @@ class LabwareTransferManipulatorControllerImpl(LabwareTransferManipulatorControl
     def __init__(self, parent_server: Server) -> None:
         super().__init__(parent_server=parent_server)
         self.robot = parent_server.robot
+        self.commands = parent_server.cancellable_commands
         self.PrepareForInput_default_lifetime_of_execution = COMMAND_LIFETIME
         self.PrepareForOutput_default_lifetime_of_execution = COMMAND_LIFETIME
         self.PutLabware_default_lifetime_of_execution = COMMAND_LIFETIME
@@ -75,6 +77,7 @@ class LabwareTransferManipulatorControllerImpl(LabwareTransferManipulatorControl
         instance.begin_execution()
         self._run(
             "PrepareForInput",
+            instance,
             lambda: self.robot.prepare_for_input(
                 HandoverPosition.Position,
                 HandoverPosition.SubPosition,
@@ -97,6 +100,7 @@ class LabwareTransferManipulatorControllerImpl(LabwareTransferManipulatorControl
         instance.begin_execution()
         self._run(
             "PrepareForOutput",
+            instance,
             lambda: self.robot.prepare_for_output(
                 HandoverPosition.Position,
                 HandoverPosition.SubPosition,
@@ -142,6 +146,7 @@ class LabwareTransferManipulatorControllerImpl(LabwareTransferManipulatorControl
         try:
             self._run(
                 command,
+                instance,
                 lambda: method(
                     handover.Position,
                     handover.SubPosition,
@@ -152,14 +157,17 @@ class LabwareTransferManipulatorControllerImpl(LabwareTransferManipulatorControl
         except TransferFailed as failure:
             raise failed(failure.message) from failure
 
-    def _run(self, command: str, action: Callable[[], T]) -> T:
-        """Translate the logic's errors; TransferFailed is left to the caller (it knows which error)."""
+    def _run(self, command: str, instance: ObservableCommandInstance, action: Callable[[], T]) -> T:
+        """Run under the execution's cancel token and translate the logic's errors; TransferFailed is
+        left to the caller (it knows which error)."""
         try:
-            return action()
+            with self.commands.running(instance):
+                return action()
         except CommandSequenceError as error:
             raise InvalidCommandSequence(str(error)) from error
         except ParameterError as error:
             raise validation_error(LabwareTransferManipulatorControllerFeature, command, error) from error
         except MotionFailed as error:
-            # The standard defines no error for a failed approach drive: an undefined execution error.
+            # The standard defines no error for a failed (or cancelled) approach drive: an undefined
+            # execution error, whose message names the cancel when there was one.
             raise RuntimeError(f"{command} failed while driving: {error.message}") from error

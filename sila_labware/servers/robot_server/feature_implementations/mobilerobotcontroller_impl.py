@@ -1,6 +1,7 @@
 """MobileRobotController: base motions around the handovers, and what the robot is and carries.
 
-Commands go to `RobotController` (dock, undock, drive, stop); the observable properties follow
+Commands go to `RobotController` (dock, undock, drive, stop), each under its execution's cancel
+token (`cancellable_commands`) so that CancelController can stop it; the observable properties follow
 the robot side's /robot_state through the bridge's topic mirror. Listeners run on the ROS thread
 and only push values into sila2's queues.
 """
@@ -65,6 +66,7 @@ class MobileRobotControllerImpl(MobileRobotControllerBase):
     def __init__(self, parent_server: Server) -> None:
         super().__init__(parent_server=parent_server)
         self.robot = parent_server.robot
+        self.commands = parent_server.cancellable_commands
         self.Dock_default_lifetime_of_execution = COMMAND_LIFETIME
         self.Undock_default_lifetime_of_execution = COMMAND_LIFETIME
         self.DriveToPointOfInterest_default_lifetime_of_execution = COMMAND_LIFETIME
@@ -89,14 +91,14 @@ class MobileRobotControllerImpl(MobileRobotControllerBase):
         instance.begin_execution()
         if self.robot.link.robot_status().docked:
             return Dock_Responses()
-        self._run("Dock", lambda: self.robot.dock(progress_reporter(instance)), DockingFailed)
+        self._run("Dock", instance, lambda: self.robot.dock(progress_reporter(instance)), DockingFailed)
         return Dock_Responses()
 
     def Undock(self, *, metadata: MetadataDict, instance: ObservableCommandInstance) -> Undock_Responses:
         instance.begin_execution()
         if not self.robot.link.robot_status().docked:
             return Undock_Responses()
-        self._run("Undock", lambda: self.robot.undock(progress_reporter(instance)), UndockingFailed)
+        self._run("Undock", instance, lambda: self.robot.undock(progress_reporter(instance)), UndockingFailed)
         return Undock_Responses()
 
     def DriveToPointOfInterest(
@@ -109,14 +111,22 @@ class MobileRobotControllerImpl(MobileRobotControllerBase):
         instance.begin_execution()
         self._run(
             "DriveToPointOfInterest",
+            instance,
             lambda: self.robot.drive_to_poi(PointOfInterest, progress_reporter(instance)),
             NavigationFailed,
         )
         return DriveToPointOfInterest_Responses()
 
-    def _run(self, command: str, motion: Callable[[], None], failure: type[Exception]) -> None:
+    def _run(
+        self,
+        command: str,
+        instance: ObservableCommandInstance,
+        motion: Callable[[], None],
+        failure: type[Exception],
+    ) -> None:
         try:
-            motion()
+            with self.commands.running(instance):
+                motion()
         except CommandSequenceError as error:
             raise RobotBusy(str(error)) from error
         except ParameterError as error:

@@ -6,10 +6,18 @@ from typing import Set
 from sila2.client import SilaClient
 from sila2.framework import FullyQualifiedFeatureIdentifier
 
-from . import labwareinventory, labwaretransfermanipulatorcontroller, mobilerobotcontroller
+from . import (
+    cancelcontroller,
+    labwareinventory,
+    labwaretransfermanipulatorcontroller,
+    mobilerobotcontroller,
+    simulationcontroller,
+)
 
 
 class Client(SilaClient):
+
+    CancelController: cancelcontroller.CancelControllerClient
 
     LabwareInventory: labwareinventory.LabwareInventoryClient
 
@@ -19,17 +27,31 @@ class Client(SilaClient):
 
     MobileRobotController: mobilerobotcontroller.MobileRobotControllerClient
 
+    SimulationController: simulationcontroller.SimulationControllerClient
+
     _expected_features: Set[FullyQualifiedFeatureIdentifier] = {
         FullyQualifiedFeatureIdentifier("org.silastandard/core/SiLAService/v1"),
+        FullyQualifiedFeatureIdentifier("org.silastandard/core.commands/CancelController/v1"),
         FullyQualifiedFeatureIdentifier("org.labwaretransfer/labware.tracking/LabwareInventory/v1"),
         FullyQualifiedFeatureIdentifier(
             "org.silastandard/instruments.labware.manipulation/LabwareTransferManipulatorController/v1"
         ),
         FullyQualifiedFeatureIdentifier("org.labwaretransfer/robotics.mobile/MobileRobotController/v1"),
+        FullyQualifiedFeatureIdentifier("org.silastandard/core/SimulationController/v1"),
     }
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
+
+        self._register_defined_execution_error_class(
+            cancelcontroller.CancelControllerFeature.defined_execution_errors["InvalidCommandExecutionUUID"],
+            cancelcontroller.InvalidCommandExecutionUUID,
+        )
+
+        self._register_defined_execution_error_class(
+            cancelcontroller.CancelControllerFeature.defined_execution_errors["OperationNotSupported"],
+            cancelcontroller.OperationNotSupported,
+        )
 
         self._register_defined_execution_error_class(
             labwareinventory.LabwareInventoryFeature.defined_execution_errors["UnknownLabware"],
@@ -90,4 +112,14 @@ class Client(SilaClient):
         self._register_defined_execution_error_class(
             mobilerobotcontroller.MobileRobotControllerFeature.defined_execution_errors["MotionStopped"],
             mobilerobotcontroller.MotionStopped,
+        )
+
+        self._register_defined_execution_error_class(
+            simulationcontroller.SimulationControllerFeature.defined_execution_errors["StartSimulationModeFailed"],
+            simulationcontroller.StartSimulationModeFailed,
+        )
+
+        self._register_defined_execution_error_class(
+            simulationcontroller.SimulationControllerFeature.defined_execution_errors["StartRealModeFailed"],
+            simulationcontroller.StartRealModeFailed,
         )

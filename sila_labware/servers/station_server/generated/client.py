@@ -6,18 +6,21 @@ from typing import Set
 from sila2.client import SilaClient
 from sila2.framework import FullyQualifiedFeatureIdentifier
 
-from . import labwaretransfersitecontroller
+from . import labwaretransfersitecontroller, simulationcontroller
 
 
 class Client(SilaClient):
 
     LabwareTransferSiteController: labwaretransfersitecontroller.LabwareTransferSiteControllerClient
 
+    SimulationController: simulationcontroller.SimulationControllerClient
+
     _expected_features: Set[FullyQualifiedFeatureIdentifier] = {
         FullyQualifiedFeatureIdentifier("org.silastandard/core/SiLAService/v1"),
         FullyQualifiedFeatureIdentifier(
             "org.silastandard/instruments.labware.manipulation/LabwareTransferSiteController/v1"
         ),
+        FullyQualifiedFeatureIdentifier("org.silastandard/core/SimulationController/v1"),
     }
 
     def __init__(self, *args, **kwargs):
@@ -28,4 +31,14 @@ class Client(SilaClient):
                 "InvalidCommandSequence"
             ],
             labwaretransfersitecontroller.InvalidCommandSequence,
+        )
+
+        self._register_defined_execution_error_class(
+            simulationcontroller.SimulationControllerFeature.defined_execution_errors["StartSimulationModeFailed"],
+            simulationcontroller.StartSimulationModeFailed,
+        )
+
+        self._register_defined_execution_error_class(
+            simulationcontroller.SimulationControllerFeature.defined_execution_errors["StartRealModeFailed"],
+            simulationcontroller.StartRealModeFailed,
         )
