@@ -97,15 +97,19 @@ class TopicMirror(Generic[M]):
             self._runtime.call(lambda: self._runtime.node.destroy_subscription(self._subscription))
 
     def _on_message(self, message: M) -> None:
+        """Listeners first, then waiters: whoever returns from `wait_for_message` with this message
+        finds everything fed by the listeners (SiLA properties) already updated. Only the ROS
+        thread calls this, so messages cannot overtake each other between the two steps."""
         message_key = self._key(message)
         with self._condition:
             changed = self._latest is None or message_key != self._latest_key
-            self._latest, self._latest_key = message, message_key
-            self._received_count += 1
             listeners = list(self._listeners) if changed else []
-            self._condition.notify_all()
         for listener in listeners:
             try:
                 listener(message)
             except Exception:  # noqa: BLE001 - a broken listener must not stop the executor
                 logger.exception("listener of %s failed", self.topic)
+        with self._condition:
+            self._latest, self._latest_key = message, message_key
+            self._received_count += 1
+            self._condition.notify_all()

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 from labware_model.holders import HotelSlot, Nest
 from labware_model.readings import HotelSlotReading
@@ -32,9 +32,18 @@ class RobotStatus:
     stamp_s: float = 0.0
     """The message stamp in seconds: the robot side's clock (simulated time in simulation)."""
 
+    # the state words of labware_interfaces/RobotState
+    DOCKED: ClassVar[str] = "docked"
+    IDLE: ClassVar[str] = "idle"
+
     @property
     def docked(self) -> bool:
-        return self.state == "docked"
+        return self.state == self.DOCKED
+
+    @property
+    def at_rest(self) -> bool:
+        """Nothing moves: standing idle, or docked."""
+        return self.state in (self.IDLE, self.DOCKED)
 
     @property
     def onboard_labware_ids(self) -> tuple[str, ...]:

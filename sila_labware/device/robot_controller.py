@@ -25,20 +25,18 @@ feedback, and on the handler thread at the end of a command. `stop_motion` and
 
 from __future__ import annotations
 
-import dataclasses
 import logging
-import threading
 from collections.abc import Callable
-from dataclasses import dataclass
 
 from labware_model.holders import HotelSlot, Nest, location_text
 from labware_model.workcell import WorkcellDescription
-from ros_bridge.errors import BridgeError, BridgeTimeout
+from ros_bridge.errors import BridgeTimeout
 from ros_bridge.goal_status import ActionGoal, ActionOutcome
 from ros_bridge.progress import CommandProgress, ProgressReport
 from ros_bridge.workcell import LabwareHandover, RobotStatus
-from sila_labware.device.cancellation import CancelToken, current_token
+from sila_labware.device.cancellation import CancelToken
 from sila_labware.device.errors import CommandSequenceError, MotionFailed, TransferFailed
+from sila_labware.device.goal_runner import ControllerWaits, GoalRunner
 from sila_labware.device.inventory import Inventory
 from sila_labware.device.robot_backend import RobotBackend
 from sila_labware.device.sequences import ManipulatorSequence, PreparedTransfer
@@ -48,21 +46,6 @@ logger = logging.getLogger(__name__)
 
 INTERMEDIATE_ACTIONS: tuple[str, ...] = ()
 """Fully qualified command identifiers this robot can run between pick and place: none yet."""
-
-
-@dataclass(frozen=True)
-class ControllerWaits:
-    """How long (s) the controller waits on the back end besides a step's own run time."""
-
-    accept_s: float = 30.0
-    """For the robot side to accept a goal."""
-    cancel_s: float = 10.0
-    """For a goal cancelled after its step timed out to end."""
-    state_report_s: float = 2.0
-    """For the robot state to show a motion's effect (/robot_state lags action results)."""
-    settle_s: float = 3.0
-    """For the robot state and a nest sensor to show a transfer's outcome (/station_states
-    comes at 2 Hz, /robot_state on change)."""
 
 
 class RobotController:
@@ -81,9 +64,7 @@ class RobotController:
         self.waits = waits or ControllerWaits()
         self.sequence = ManipulatorSequence()
         self.inventory = Inventory()
-        self._active_goal: ActionGoal | None = None
-        self._active_token: CancelToken | None = None  # the cancel token of the command that sent it
-        self._active_lock = threading.Lock()
+        self.goals = GoalRunner(link, step_timeout_s, self.waits)
         self.parameters = DeviceParameters(
             {station.name: station.sub_positions for station in workcell.stations},
             workcell.hotel_slots,
@@ -189,7 +170,7 @@ class RobotController:
             )
             send = self.link.get_labware if getting else self.link.put_labware
             progress = CommandProgress(report)
-            outcome = self._wait(lambda: send(request, progress.step(0.0, 1.0)), command)
+            outcome = self.goals.run(lambda: send(request, progress.step(0.0, 1.0)), command)
             labware_id = transfer.labware_id or str(getattr(outcome.result, "labware_id", ""))
             self._settle(labware_id, transfer, outcome, expect_aboard=getting)
             if not outcome.success:
@@ -203,12 +184,12 @@ class RobotController:
     def dock(self, report: ProgressReport | None = None) -> None:
         progress = CommandProgress(report)
         self._motion("Dock", lambda: self.link.dock(progress.step(0.0, 1.0)))
-        self._await_state_report(lambda status: status.docked, "docked")
+        self.goals.await_state(lambda status: status.docked, "docked")
 
     def undock(self, report: ProgressReport | None = None) -> None:
         progress = CommandProgress(report)
         self._motion("Undock", lambda: self.link.undock(progress.step(0.0, 1.0)))
-        self._await_state_report(lambda status: not status.docked, "undocked")
+        self.goals.await_state(lambda status: status.state == RobotStatus.IDLE, "idle off the dock")
 
     def drive_to_poi(self, poi: str, report: ProgressReport | None = None) -> None:
         self.parameters.point_of_interest(poi)
@@ -221,55 +202,35 @@ class RobotController:
         self._await_arrival_report(poi)
 
     def stop_motion(self) -> bool:
-        """Cancel whatever goal runs; True if one was running."""
-        with self._active_lock:
-            goal = self._active_goal
-        if goal is None or goal.done:
-            return False
-        goal.cancel()
-        return True
+        """Cancel whatever goal runs; returns once the robot stands (see GoalRunner.stop)."""
+        return self.goals.stop()
 
     def cancel_command(self, token: CancelToken, reason: str) -> bool:
         """Cancel the command running under `token` (see `cancellation`): its running goal now, and
         any goal it would send next. True if one of its goals was running."""
-        token.cancel(reason)
-        with self._active_lock:
-            goal = self._active_goal if self._active_token is token else None
-        if goal is None or goal.done:
-            return False
-        goal.cancel()
-        return True
+        return self.goals.cancel(token, reason)
 
     def abort_active_goal(self, reason: str) -> bool:
         """End the waiting command now (the robot side is gone and will not answer): its goal ends
         with GoalAbandoned(`reason`); True if a goal was still running. The command then settles
         the inventory and raises its defined error as for any failed goal. Any thread."""
-        with self._active_lock:
-            goal = self._active_goal
-        return goal is not None and goal.abort(reason)
+        return self.goals.abort(reason)
 
     # --- helpers ---
 
     def _motion(self, command: str, send: Callable[[], ActionGoal]) -> None:
         self.sequence.begin_motion(command)
         try:
-            outcome = self._wait(send, command)
+            outcome = self.goals.run(send, command)
             if not outcome.success:
                 raise MotionFailed(outcome.error_code, _describe_failure(command, outcome))
         finally:
             self.sequence.finish_motion()
 
     def _await_arrival_report(self, poi: str) -> None:
-        self._await_state_report(lambda status: status.current_poi == poi, f"at {poi}")
-
-    def _await_state_report(self, shows: Callable[[RobotStatus], bool], what: str) -> None:
-        """After a base motion succeeded, wait until /robot_state shows its effect, so that the
-        command ends with the state properties (and the next command's checks) already true: the
-        state topic lags action results."""
-        try:
-            self.link.wait_for_robot_status(shows, self.waits.state_report_s)
-        except BridgeTimeout:
-            logger.warning("the motion succeeded but the robot state does not report %s yet", what)
+        self.goals.await_state(
+            lambda status: status.current_poi == poi and status.state == RobotStatus.IDLE, f"idle at {poi}"
+        )
 
     def _drive_for_transfer(self, handover: Nest, progress: CommandProgress) -> None:
         """Undock if needed, then drive to the station's POI (unless already there)."""
@@ -280,12 +241,12 @@ class RobotController:
             status = self.link.robot_status()
             start = 0.0
             if status.docked:
-                outcome = self._wait(lambda: self.link.undock(progress.step(0.0, 0.2)), "Undock")
+                outcome = self.goals.run(lambda: self.link.undock(progress.step(0.0, 0.2)), "Undock")
                 if not outcome.success:
                     raise MotionFailed(outcome.error_code, _describe_failure("Undock", outcome))
                 start = 0.2
             if status.current_poi != station.poi or status.docked:
-                outcome = self._wait(
+                outcome = self.goals.run(
                     lambda: self.link.navigate_to_poi(station.poi, progress.step(start, 1.0)),
                     "NavigateToPoi",
                 )
@@ -298,44 +259,6 @@ class RobotController:
             success = True
         finally:
             self.sequence.finish_prepare(success)
-
-    def _wait(self, send: Callable[[], ActionGoal], what: str) -> ActionOutcome:
-        """Send the goal and return its outcome; back-end trouble (no answer, rejection, timeout, an
-        abandoned goal, even while sending) becomes a failed outcome whose error code names the
-        bridge error, so that callers always settle the inventory and raise their own defined error.
-        A command cancelled through its token sends no further goal."""
-        token = current_token()
-        if token is not None and token.cancelled:
-            return ActionOutcome(False, "CANCELED", f"{token.reason}; {what} was not started", "CANCELED")
-        try:
-            goal = send()
-        except BridgeError as error:
-            return ActionOutcome(False, type(error).__name__, f"{what} could not be sent: {error}", "")
-        with self._active_lock:
-            self._active_goal, self._active_token = goal, token
-        try:
-            if token is not None and token.cancelled:  # cancelled while the goal was being sent
-                goal.cancel()
-            goal.wait_accepted(self.waits.accept_s)
-            try:
-                outcome = goal.result(self.step_timeout_s)
-                if token is not None and token.cancelled and not outcome.success:
-                    outcome = dataclasses.replace(outcome, message=f"{token.reason}; {outcome.message}")
-                return outcome
-            except BridgeTimeout:
-                logger.warning("%s took longer than %.0f s: cancelling it", what, self.step_timeout_s)
-                goal.cancel()
-                try:
-                    return goal.result(self.waits.cancel_s)
-                except BridgeTimeout:
-                    return ActionOutcome(
-                        False, "TIMEOUT", f"{what}: no result within {self.step_timeout_s:.0f} s", ""
-                    )
-        except BridgeError as error:
-            return ActionOutcome(False, type(error).__name__, str(error), "")
-        finally:
-            with self._active_lock:
-                self._active_goal, self._active_token = None, None
 
     def _settle(
         self, labware_id: str, transfer: PreparedTransfer, outcome: ActionOutcome, expect_aboard: bool
