@@ -17,8 +17,9 @@ import threading
 from collections.abc import Callable
 from dataclasses import dataclass
 
-ProgressReport = Callable[[float, float], None]
-"""Called with (fraction done 0..1, estimated remaining time in s)."""
+ProgressReport = Callable[[float, float | None], None]
+"""Called with (fraction done 0..1, estimated remaining time in wall seconds, or None where there
+is no estimate: never 0 while work remains)."""
 
 
 @dataclass(frozen=True)
@@ -62,8 +63,13 @@ class CommandProgress:
     across goals too (a later goal whose share starts lower cannot pull it back). `report` may be
     None: the command then runs without anyone watching."""
 
-    def __init__(self, report: ProgressReport | None) -> None:
+    def __init__(
+        self, report: ProgressReport | None, to_wall_s: Callable[[float], float] = lambda seconds: seconds
+    ) -> None:
+        """`to_wall_s` turns a remaining time on the robot's clock into wall seconds (see
+        `robot_pace`); by default the two clocks are one."""
         self._report = report
+        self._to_wall_s = to_wall_s
         self._fraction = MonotonicProgress()
         self._lock = threading.Lock()  # keeps reports in order when two threads report at once
 
@@ -71,20 +77,25 @@ class CommandProgress:
     def fraction(self) -> float:
         return self._fraction.fraction
 
-    def step(self, start: float, end: float) -> Callable[[GoalProgress], None]:
-        """A feedback listener for the goal that covers [start, end] of this command."""
+    def step(self, start: float, end: float, *, last: bool = True) -> Callable[[GoalProgress], None]:
+        """A feedback listener for the goal that covers [start, end] of this command. The goal's
+        remaining time is the command's only for its `last` goal (the goals after an earlier one
+        have no estimate yet), and only where the robot side gave one (a remaining time of 0
+        before the goal is done means none)."""
 
         def on_goal_progress(progress: GoalProgress) -> None:
-            self.report(start + (end - start) * progress.progress, progress.remaining_time_s)
+            known = last and (progress.remaining_time_s > 0.0 or progress.progress >= 1.0)
+            remaining = self._to_wall_s(progress.remaining_time_s) if known else None
+            self.report(start + (end - start) * progress.progress, remaining)
 
         return on_goal_progress
 
-    def report(self, fraction: float, remaining_time_s: float) -> None:
-        """Report the command's own fraction done and the remaining time in s (>= 0)."""
+    def report(self, fraction: float, remaining_s: float | None) -> None:
+        """Report the command's own fraction done and the remaining wall seconds (None: unknown)."""
         with self._lock:
             shown = self._fraction.advance(fraction)
             if self._report is not None:
-                self._report(shown, max(0.0, remaining_time_s))
+                self._report(shown, None if remaining_s is None else max(0.0, remaining_s))
 
     def finish(self) -> None:
         """The command's work is done: report 1 with nothing remaining."""

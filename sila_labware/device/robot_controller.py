@@ -33,6 +33,7 @@ from labware_model.workcell import WorkcellDescription
 from ros_bridge.errors import BridgeTimeout
 from ros_bridge.goal_status import ActionGoal, ActionOutcome
 from ros_bridge.progress import CommandProgress, ProgressReport
+from ros_bridge.robot_pace import RobotPace
 from ros_bridge.workcell import LabwareHandover, RobotStatus
 from sila_labware.device.cancellation import CancelToken
 from sila_labware.device.errors import CommandSequenceError, MotionFailed, TransferFailed
@@ -71,7 +72,9 @@ class RobotController:
             workcell.pois,
             INTERMEDIATE_ACTIONS,
         )
+        self.pace = RobotPace()  # remaining times are reported in wall seconds at the robot's pace
         link.on_robot_status(self.inventory.observe_robot)
+        link.on_robot_status(self.pace.observe)
         self.inventory.observe_robot(link.robot_status())
 
     # --- what the robot offers ---
@@ -107,7 +110,7 @@ class RobotController:
             )
         transfer = PreparedTransfer(handover, internal_position, labware_type, labware_id)
         self.sequence.begin_prepare_for_input(transfer)
-        self._drive_for_transfer(handover, CommandProgress(report))
+        self._drive_for_transfer(handover, CommandProgress(report, self.pace.to_wall_s))
 
     def prepare_for_output(
         self, position: str, sub_position: int, internal_position: int, report: ProgressReport | None = None
@@ -125,7 +128,7 @@ class RobotController:
             handover, internal_position, known.labware_type if known else "", occupant
         )
         self.sequence.begin_prepare_for_output(transfer)
-        self._drive_for_transfer(handover, CommandProgress(report))
+        self._drive_for_transfer(handover, CommandProgress(report, self.pace.to_wall_s))
 
     def get_labware(
         self,
@@ -169,7 +172,7 @@ class RobotController:
                 intermediate_actions,
             )
             send = self.link.get_labware if getting else self.link.put_labware
-            progress = CommandProgress(report)
+            progress = CommandProgress(report, self.pace.to_wall_s)
             outcome = self.goals.run(lambda: send(request, progress.step(0.0, 1.0)), command)
             labware_id = transfer.labware_id or str(getattr(outcome.result, "labware_id", ""))
             self._settle(labware_id, transfer, outcome, expect_aboard=getting)
@@ -182,12 +185,12 @@ class RobotController:
     # --- base motions outside the standard ---
 
     def dock(self, report: ProgressReport | None = None) -> None:
-        progress = CommandProgress(report)
+        progress = CommandProgress(report, self.pace.to_wall_s)
         self._motion("Dock", lambda: self.link.dock(progress.step(0.0, 1.0)))
         self.goals.await_state(lambda status: status.docked, "docked")
 
     def undock(self, report: ProgressReport | None = None) -> None:
-        progress = CommandProgress(report)
+        progress = CommandProgress(report, self.pace.to_wall_s)
         self._motion("Undock", lambda: self.link.undock(progress.step(0.0, 1.0)))
         self.goals.await_state(lambda status: status.state == RobotStatus.IDLE, "idle off the dock")
 
@@ -195,7 +198,7 @@ class RobotController:
         self.parameters.point_of_interest(poi)
         if self.link.robot_status().docked:
             raise MotionFailed("DOCKED", f"the robot is docked; undock before driving to {poi!r}")
-        progress = CommandProgress(report)
+        progress = CommandProgress(report, self.pace.to_wall_s)
         self._motion(
             "DriveToPointOfInterest", lambda: self.link.navigate_to_poi(poi, progress.step(0.0, 1.0))
         )
@@ -241,7 +244,9 @@ class RobotController:
             status = self.link.robot_status()
             start = 0.0
             if status.docked:
-                outcome = self.goals.run(lambda: self.link.undock(progress.step(0.0, 0.2)), "Undock")
+                outcome = self.goals.run(
+                    lambda: self.link.undock(progress.step(0.0, 0.2, last=False)), "Undock"
+                )
                 if not outcome.success:
                     raise MotionFailed(outcome.error_code, _describe_failure("Undock", outcome))
                 start = 0.2

@@ -42,10 +42,11 @@ def progress_reporter(instance: ObservableCommandInstance) -> ProgressReport:
     owns the rule that a command's progress stays in 0..1 and never goes down, across all the
     goals of the command; this only writes them, in the order they come."""
 
-    def report(progress: float, remaining_s: float) -> None:
+    def report(progress: float, remaining_s: float | None) -> None:
         try:
             instance.progress = progress
-            instance.estimated_remaining_time = timedelta(seconds=remaining_s)
+            if remaining_s is not None:  # no estimate: leave it unset rather than claim 0
+                instance.estimated_remaining_time = timedelta(seconds=remaining_s)
         except Exception:  # noqa: BLE001 - a closed instance must not break the ROS thread
             logger.debug("could not update a command instance", exc_info=True)
 

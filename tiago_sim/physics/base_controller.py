@@ -10,10 +10,12 @@ odometry only. Lives on the sim thread.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
-from tiago_sim.physics.motion import CANCELED, Motion
+from tiago_sim.lab.world import Pose2D
+from tiago_sim.physics.motion import CANCELED, Motion, SequenceMotion
 from tiago_sim.physics.robot_body import RobotBody
 from tiago_sim.robot import robot_model as rm
 
@@ -35,6 +37,26 @@ def _ramp(current: float, desired: float, max_change: float) -> float:
 def _speed_for_distance(distance: float, accel: float, max_speed: float) -> float:
     """Largest speed from which the remaining distance suffices to stop."""
     return min(max_speed, math.sqrt(2.0 * accel * max(distance, 0.0)))
+
+
+def _profile_s(amount: float, accel: float, max_speed: float) -> float:
+    """Time to cover `amount` (m or rad) from rest to rest with a trapezoidal speed profile."""
+    amount = abs(amount)
+    if amount * accel >= max_speed**2:
+        return amount / max_speed + max_speed / accel
+    return 2.0 * math.sqrt(amount / accel)
+
+
+SETTLE_S = 0.5  # s: the heading loop closes its last millimetres and milliradians
+
+
+def drive_duration_s(turn_rad: float, distance_m: float, align_rad: float, speed: float) -> float:
+    """How long a drive takes with TIAGo's limits: turn to the bearing, drive, turn to the goal
+    heading (each at 80 % of the acceleration limits, as DriveMotion commands them)."""
+    turning = _profile_s(turn_rad, rm.MAX_ANGULAR_ACCEL * 0.8, rm.MAX_ANGULAR_SPEED)
+    aligning = _profile_s(align_rad, rm.MAX_ANGULAR_ACCEL * 0.8, rm.MAX_ANGULAR_SPEED)
+    driving = _profile_s(distance_m, rm.MAX_LINEAR_ACCEL * 0.8, speed)
+    return turning + driving + aligning + SETTLE_S
 
 
 class DiffDriveBase:
@@ -140,6 +162,7 @@ class DriveMotion(Motion):
         self.stop_when = stop_when
         self.phase = "turning"
         self.start_distance = max(self._distance(), 1e-6)
+        self.remaining_s = self._estimate_remaining_s(self._distance())
 
     def _distance(self) -> float:
         x, y, _ = self.base.odom
@@ -151,6 +174,17 @@ class DriveMotion(Motion):
         if self.reverse:
             bearing += math.pi
         return wrap_angle(bearing - yaw)
+
+    def _estimate_remaining_s(self, distance: float) -> float:
+        """What is left of the drive in the current phase and after it, from TIAGo's limits."""
+        x, y, yaw = self.base.odom
+        moving = distance > POSITION_TOLERANCE * 2
+        bearing = math.atan2(self.goal[1] - y, self.goal[0] - x) + (math.pi if self.reverse else 0.0)
+        if self.phase == "aligning" or not moving:
+            return drive_duration_s(0.0, 0.0, wrap_angle(self.goal[2] - yaw), self.speed)
+        align = wrap_angle(self.goal[2] - bearing)
+        turn = wrap_angle(bearing - yaw) if self.phase == "turning" else 0.0
+        return drive_duration_s(turn, distance, align, self.speed)
 
     def _turn_rate(self, error: float) -> float:
         return math.copysign(
@@ -172,7 +206,7 @@ class DriveMotion(Motion):
             return
         distance = self._distance()
         self.progress = float(np.clip(1.0 - distance / self.start_distance, 0.0, 0.99))
-        self.remaining_s = distance / max(self.speed, 1e-3) + 1.0
+        self.remaining_s = self._estimate_remaining_s(distance)
         if self.phase == "turning":
             error = self._heading_error() if distance > POSITION_TOLERANCE * 2 else 0.0
             base.command(0.0, self._turn_rate(error))
@@ -204,3 +238,36 @@ class DriveMotion(Motion):
     def finish(self, success: bool, error_code: str = "", message: str = "") -> None:
         self.base.command(0.0, 0.0)
         super().finish(success, error_code, message)
+
+
+DOCK_SPEED = 0.05  # m/s backing onto the dock: stops within 3 mm once the contacts close
+DOCK_OVERTRAVEL = 0.08  # m: the reverse drive aims this far past the docked pose, contact ends it
+
+
+def docking_motion(
+    base: DiffDriveBase, approach: Pose2D, dock: Pose2D, docked: Callable[[], bool]
+) -> SequenceMotion:
+    """Drive to the dock's approach pose, then back onto the dock slowly until `docked()` (the
+    charging contacts) says so; each stage with its time estimate, so the remaining time counts
+    the slow last stretch from the start."""
+    beyond = (dock.x - DOCK_OVERTRAVEL * math.cos(dock.yaw), dock.y - DOCK_OVERTRAVEL * math.sin(dock.yaw))
+    x, y, yaw = base.odom
+    bearing = math.atan2(approach.y - y, approach.x - x)
+    approach_s = drive_duration_s(
+        wrap_angle(bearing - yaw),
+        math.hypot(approach.x - x, approach.y - y),
+        wrap_angle(approach.yaw - bearing),
+        rm.MAX_LINEAR_SPEED,
+    )
+    docking_s = drive_duration_s(0.0, math.hypot(dock.x - approach.x, dock.y - approach.y), 0.0, DOCK_SPEED)
+
+    def back_onto_dock() -> DriveMotion:
+        return DriveMotion(
+            base, *beyond, dock.yaw, reverse=True, speed=DOCK_SPEED, stop_when=docked, name="dock_in"
+        )
+
+    stages = [
+        ("approach", lambda: DriveMotion(base, approach.x, approach.y, approach.yaw), 0.7, approach_s),
+        ("docking", back_onto_dock, 0.3, docking_s),
+    ]
+    return SequenceMotion("dock", stages, frozenset({"base"}))

@@ -93,7 +93,9 @@ class CompletedMotion(Motion):
 
 
 class SequenceMotion(Motion):
-    """Runs motions made by ``stages`` one after another; each stage is (phase, factory, weight).
+    """Runs motions made by ``stages`` one after another; each stage is (phase, factory, weight,
+    estimated seconds). The remaining time is the running stage's own estimate plus the estimates
+    of the stages after it.
 
     A factory is called when its stage starts, so it can use the state the previous stage left.
     """
@@ -101,14 +103,15 @@ class SequenceMotion(Motion):
     def __init__(
         self,
         name: str,
-        stages: Sequence[tuple[str, Callable[[], Motion], float]],
+        stages: Sequence[tuple[str, Callable[[], Motion], float, float]],
         resources: frozenset[str] = frozenset(),
     ) -> None:
         super().__init__(name, resources)
         self.stages = list(stages)
+        self.remaining_s = sum(estimate for *_, estimate in self.stages)
         self.index = -1
         self.current: Motion | None = None
-        self.total_weight = sum(weight for _, _, weight in self.stages) or 1.0
+        self.total_weight = sum(weight for _, _, weight, _ in self.stages) or 1.0
         self.weight_done = 0.0
 
     def cancel(self) -> None:
@@ -130,7 +133,7 @@ class SequenceMotion(Motion):
             if self.index >= len(self.stages):
                 self.finish(True)
                 return
-            self.phase, factory, _ = self.stages[self.index]
+            self.phase, factory, _, _ = self.stages[self.index]
             self.current = factory()
             if self.current.done:  # failed at once
                 self.tick(0.0)
@@ -138,4 +141,5 @@ class SequenceMotion(Motion):
         self.current.advance(dt)
         weight = self.stages[self.index][2]
         self.progress = min(1.0, (self.weight_done + weight * self.current.progress) / self.total_weight)
-        self.remaining_s = self.current.remaining_s
+        later_s = sum(estimate for *_, estimate in self.stages[self.index + 1 :])
+        self.remaining_s = self.current.remaining_s + later_s

@@ -21,10 +21,10 @@ from labware_model.readings import HotelSlotReading, NestReading, PlacementCheck
 from tiago_sim.lab.world import World
 from tiago_sim.perception.camera import CameraIntrinsics, render_rgbd
 from tiago_sim.physics.arm_controller import JointTrajectoryMotion
-from tiago_sim.physics.base_controller import DiffDriveBase, DriveMotion
+from tiago_sim.physics.base_controller import DiffDriveBase, DriveMotion, docking_motion
 from tiago_sim.physics.gripper_controller import Gripper, GripperMotion
 from tiago_sim.physics.hotel_clamp import HotelClamp
-from tiago_sim.physics.motion import BUSY, CompletedMotion, FailedMotion, Motion, SequenceMotion
+from tiago_sim.physics.motion import BUSY, CompletedMotion, FailedMotion, Motion
 from tiago_sim.physics.plate_sensing import PlateSensing
 from tiago_sim.physics.robot_body import RobotBody
 from tiago_sim.physics.scene import build_scene
@@ -66,8 +66,6 @@ STEP_REVIEW_PERIOD = 0.05  # s of sim time between proximity checks (tool <= 1.5
 HELD_PLATE_MARGIN = 0.03  # m
 LOADED_TURN_RATE = 0.05  # rad/s: above it, with an unclamped plate in the hotel, steps stay short
 DOCK_SENSOR_RANGE = 0.004  # m: the charging contacts close within this distance
-DOCK_SPEED = 0.05  # m/s backing onto the dock: stops within 3 mm once the contacts close
-DOCK_OVERTRAVEL = 0.08  # m: the reverse drive aims this far past the docked pose, contact ends it
 TOOL_SPEED = 0.08  # m/s along straight tool moves unless the caller asks otherwise
 # Arms folded beside the torso (PAL's "home"), head level.
 HOME_ARM = (0.2, -1.1, -0.2, 1.94, -1.57, 1.37, 0.0)
@@ -293,28 +291,7 @@ class Simulation:
         if self.is_docked():
             return CompletedMotion("dock", "already docked")
         approach = self.world.pois[self.world.dock_poi]
-        dock = self.world.dock_pose
-        beyond = (
-            dock.x - DOCK_OVERTRAVEL * math.cos(dock.yaw),
-            dock.y - DOCK_OVERTRAVEL * math.sin(dock.yaw),
-        )
-        stages = [
-            ("approach", lambda: DriveMotion(self.base, approach.x, approach.y, approach.yaw), 0.7),
-            (
-                "docking",
-                lambda: DriveMotion(
-                    self.base,
-                    *beyond,
-                    dock.yaw,
-                    reverse=True,
-                    speed=DOCK_SPEED,
-                    stop_when=self.is_docked,
-                    name="dock_in",
-                ),
-                0.3,
-            ),
-        ]
-        return self._start(SequenceMotion("dock", stages, frozenset({"base"})))
+        return self._start(docking_motion(self.base, approach, self.world.dock_pose, self.is_docked))
 
     def undock(self) -> Motion:
         """Drive straight ahead off the dock, as far as the dock POI lies in front of the dock."""

@@ -90,3 +90,56 @@ def test_dock_answers_with_the_robot_docked(cell: Cell) -> None:
     mobile = cell.robot.MobileRobotController
     finish(mobile.Dock())
     assert mobile.RobotState.get() == "Docked"
+
+
+def remaining_while_running(instance: Any) -> list[tuple[float, float | None]]:
+    """(progress, remaining wall seconds or None) as a client sees them until the command ends."""
+    seen: list[tuple[float, float | None]] = []
+    while not instance.done:
+        remaining = instance.estimated_remaining_time
+        seen.append((instance.progress or 0.0, None if remaining is None else remaining.total_seconds()))
+        time.sleep(0.01)
+    return seen
+
+
+def drive(cell: Cell) -> Any:
+    return cell.robot.MobileRobotController.DriveToPointOfInterest(PointOfInterest="station_b_work")
+
+
+def dock(cell: Cell) -> Any:
+    return cell.robot.MobileRobotController.Dock()
+
+
+def prepare_from_the_dock(cell: Cell) -> Any:
+    """Undock (no estimate yet of the drive after it), then drive to station B."""
+    return cell.manipulator.PrepareForInput(
+        HandoverPosition={"Position": "station_b", "SubPosition": 2},
+        InternalPosition=1,
+        LabwareType="",
+        LabwareUniqueID="",
+    )
+
+
+@pytest.mark.parametrize(
+    ("start", "from_the_dock"),
+    [(drive, False), (dock, False), (prepare_from_the_dock, True)],
+    ids=["drive", "dock", "prepare"],
+)
+def test_remaining_time_is_never_zero_while_the_robot_still_moves(
+    cell: Cell, start: Callable[[Cell], Any], from_the_dock: bool
+) -> None:
+    """Robot commands estimate the rest from the path and the robot's limits, in wall seconds at
+    the current pace; where there is no estimate (the undock before the drive of a Prepare) it is
+    left unset: never 0 while work remains."""
+    mobile = cell.robot.MobileRobotController
+    docked = mobile.RobotState.get() == "Docked"
+    if docked != from_the_dock:
+        finish(mobile.Dock() if from_the_dock else mobile.Undock())
+    set_node_parameter(cell.deployment.runtime, "realtime_factor_cap", 2.0)  # slow enough to watch
+    try:
+        seen = remaining_while_running(start(cell))
+    finally:
+        set_node_parameter(cell.deployment.runtime, "realtime_factor_cap", 0.0)
+    assert len(seen) > 20, "the command ended before a client could watch it"
+    assert all(remaining is None or remaining > 0.0 for progress, remaining in seen if progress < 0.99), seen
+    assert any(remaining is not None and remaining > 0.0 for _, remaining in seen), seen
