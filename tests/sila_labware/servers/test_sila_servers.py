@@ -219,11 +219,8 @@ def test_motion_commands_map_robot_side_errors(robot: SilaClient) -> None:
         lambda: motion.DriveToPointOfInterest(PointOfInterest="station_a_work"),
         "undock before driving",
     )
-    expect_defined(
-        "UnknownPointOfInterest",
-        lambda: motion.DriveToPointOfInterest(PointOfInterest="nowhere"),
-        "no point of interest 'nowhere'",
-    )
+    with pytest.raises(ValidationError, match="no point of interest 'nowhere'"):
+        motion.DriveToPointOfInterest(PointOfInterest="nowhere")  # refused on the initiating call
     finish(lambda: motion.Dock())  # already docked: succeeds at once
     assert motion.RobotState.get() == "Docked"
 
