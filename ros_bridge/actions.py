@@ -9,6 +9,9 @@ Threads: `ActionCaller` and `ActionGoal` are used from caller threads (SiLA hand
 rclpy call is handed to the ROS thread of a `RosRuntime`; rclpy's answers arrive there, so the
 goal's progress listeners and completion callbacks run on the ROS thread: keep them short.
 
+When the runtime ends (stopped, or its ROS thread died), every goal still open ends at once with
+GoalAbandoned naming why: nothing could answer it any more.
+
 Our actions share one feedback shape (progress 0..1, phase, remaining_time_s) and one result
 shape (success, error_code, message); other fields of the result stay reachable as `result`.
 """
@@ -44,8 +47,10 @@ _STATUS_NAMES = {
 class _GoalOverRos:
     """The creator of one `ActionGoal`: finishes it from rclpy's answers, cancels it on request.
 
-    Threads: the `_on_*` methods run on the ROS thread (rclpy callbacks) and never raise;
-    `cancel` runs on the caller's thread and hands the rclpy call over."""
+    Threads: the `_on_*` methods run on the ROS thread (rclpy callbacks) and never raise: rclpy
+    re-raises a callback's exception from the executor, which would end the ROS thread; one that
+    fails ends the goal with BridgeError instead. `cancel` runs on the caller's thread and hands
+    the rclpy call over."""
 
     def __init__(self, runtime: RosRuntime, action_name: str) -> None:
         self._runtime = runtime
@@ -82,6 +87,22 @@ class _GoalOverRos:
 
     # --- ROS thread only below ---
 
+    def on_feedback(self, feedback_message: Any) -> None:
+        self._guarded("feedback", self._on_feedback, feedback_message)
+
+    def on_goal_response(self, response_future: Any) -> None:
+        self._guarded("the goal response", self._on_goal_response, response_future)
+
+    def on_result(self, result_future: Any) -> None:
+        self._guarded("the result", self._on_result, result_future)
+
+    def _guarded(self, what: str, handle: Callable[[Any], None], answer: Any) -> None:
+        try:
+            handle(answer)
+        except Exception as error:  # noqa: BLE001 - must not reach the executor (see the class)
+            logger.exception("%s: handling %s failed", self._name, what)
+            self.status.set_exception(BridgeError(f"{self._name}: handling {what} failed: {error}"))
+
     def _on_feedback(self, feedback_message: Any) -> None:
         feedback = feedback_message.feedback
         self.status.update_progress(
@@ -102,10 +123,22 @@ class _GoalOverRos:
         with self._lock:
             self._ros_handle = ros_handle
             cancel_now = self._cancel_requested
-        self.status.set_accepted()
-        ros_handle.get_result_async().add_done_callback(self._on_result)
         if cancel_now:
-            ros_handle.cancel_goal_async()
+            if self.status.done:
+                logger.warning("%s: accepted after it was withdrawn: cancelling it", self._name)
+            ros_handle.cancel_goal_async().add_done_callback(
+                lambda answer: self._guarded("the cancel answer", self._on_late_cancel_answer, answer)
+            )
+        self.status.set_accepted()
+        ros_handle.get_result_async().add_done_callback(self.on_result)
+
+    def _on_late_cancel_answer(self, cancel_future: Any) -> None:
+        """The answer to a cancel sent when the acceptance came: only logged (nobody waits for it)."""
+        error = cancel_future.exception()
+        if error is not None:
+            logger.error("%s: cancelling a goal accepted too late failed: %s", self._name, error)
+        elif not cancel_future.result().goals_canceling:
+            logger.error("%s: the robot side refused to cancel a goal accepted too late", self._name)
 
     def _on_result(self, result_future: Any) -> None:
         error = result_future.exception()
@@ -128,9 +161,12 @@ class ActionCaller:
         self._runtime = runtime
         self.action_type = action_type
         self.action_name = action_name
+        self._open_goals: set[ActionGoal] = set()
+        self._open_lock = threading.Lock()
         self._client: ActionClient = runtime.call(
             lambda: runtime.own(ActionClient(runtime.node, action_type, action_name))
         )
+        runtime.add_end_listener(self._abandon_open_goals)
 
     def is_ready(self) -> bool:
         return bool(self._runtime.call(self._client.server_is_ready))
@@ -154,12 +190,21 @@ class ActionCaller:
         over_ros = _GoalOverRos(self._runtime, self.action_name)
         if on_feedback is not None:
             over_ros.status.add_progress_listener(on_feedback)
+        with self._open_lock:
+            self._open_goals.add(over_ros.status)
+        over_ros.status.add_callback(self._forget)
 
         def send_on_ros_thread() -> None:
-            response_future = self._client.send_goal_async(goal, feedback_callback=over_ros._on_feedback)
-            response_future.add_done_callback(over_ros._on_goal_response)
+            response_future = self._client.send_goal_async(goal, feedback_callback=over_ros.on_feedback)
+            response_future.add_done_callback(over_ros.on_goal_response)
 
-        self._runtime.call(send_on_ros_thread)
+        try:
+            self._runtime.call(send_on_ros_thread)
+        except BridgeError as error:
+            # Reported as not sent: should it have gone out after all (the ROS thread took the call
+            # but did not finish it in time), its acceptance cancels it, as for any withdrawn goal.
+            over_ros.status.withdraw(f"the goal could not be sent: {error}")
+            raise
         return over_ros.status
 
     def run(
@@ -169,7 +214,8 @@ class ActionCaller:
         on_feedback: Callable[[GoalProgress], None] | None = None,
         accept_timeout_s: float = 10.0,
     ) -> ActionOutcome:
-        """Send, wait for acceptance and for the outcome; cancel the goal if it times out."""
+        """Send, wait for acceptance and for the outcome; cancel the goal if it times out. A goal
+        not accepted within `accept_timeout_s` is withdrawn (`ActionGoal.wait_accepted`)."""
         status = self.send(goal, on_feedback)
         status.wait_accepted(accept_timeout_s)
         try:
@@ -180,6 +226,18 @@ class ActionCaller:
 
     def destroy(self) -> None:
         self._runtime.call(self._client.destroy)
+
+    def _forget(self, goal: ActionGoal) -> None:
+        with self._open_lock:
+            self._open_goals.discard(goal)
+
+    def _abandon_open_goals(self, reason: str) -> None:
+        """The runtime ended: no answer can reach a goal still open, so end each with GoalAbandoned
+        now rather than leave its waiter to its timeout (a step's is 10 minutes)."""
+        with self._open_lock:
+            goals = list(self._open_goals)
+        for goal in goals:
+            goal.abort(f"no answer can come: {reason}")
 
 
 def _copy_ros_future(ros_future: Any, target: concurrent.futures.Future) -> None:

@@ -14,14 +14,22 @@ pending to accepted (or rejected) to finished, and it finishes exactly once, in 
 
 Who may finish a status: its creator only - `set_accepted`, `set_rejected`, `update_progress`,
 `set_finished` and `set_exception` are the creator's; for `ActionCaller` they run on the ROS
-thread, from rclpy's callbacks. One exception: `abort(reason)` is public for whoever knows that
-the robot side is gone and will never answer (the deployment's supervisor, through
-`RobotController.abort_active_goal`); it finishes the goal with `GoalAbandoned`. The recipient
-otherwise reads, waits, listens, and may ask to `cancel()`: a cancelled goal is finished by its
-creator when the robot side confirms (outcome status CANCELED), not by the canceller.
+thread, from rclpy's callbacks. Two exceptions, both for a recipient that stops waiting:
+- `abort(reason)`, for whoever knows that the robot side is gone and will never answer (the
+  deployment's supervisor, through `RobotController.abort_active_goal`); it finishes the goal with
+  `GoalAbandoned` and sends nothing;
+- `withdraw(reason)`, which `wait_accepted` calls when no acceptance came in time: it asks the
+  creator to cancel the goal (at once if the robot side accepted it meanwhile, else as soon as a
+  late acceptance arrives, so a goal reported as failed never runs unnoticed), and finishes the
+  goal with `BridgeTimeout`.
+The recipient otherwise reads, waits, listens, and may ask to `cancel()`: a cancelled goal is
+finished by its creator when the robot side confirms (outcome status CANCELED), not by the
+canceller.
 
-Completion is idempotent: the first of set_finished / set_rejected / set_exception / abort wins;
-later ones change nothing, return False and are logged at debug level. Unlike ophyd (which raises
+Completion is idempotent and atomic: the first of set_finished / set_rejected / set_exception /
+abort / withdraw wins, under the goal's lock, so exactly one end is recorded and the callbacks run
+once, on the thread of that first end (the ROS thread, or the supervisor's after `abort`); later
+ends change nothing, return False and are logged at debug level. Unlike ophyd (which raises
 InvalidState on a second completion) they never raise, because they run in rclpy done-callbacks,
 where an exception would end the ROS executor thread, and a late robot answer racing an `abort`
 is normal, not a bug.
@@ -34,6 +42,8 @@ Progress: `progress` is the robot side's latest feedback; its fraction done (0..
 (`ros_bridge.progress.MonotonicProgress`) and becomes 1 ("done") when the goal succeeds. Progress
 listeners are called on every feedback, on the thread that delivers it (the ROS thread for
 `ActionCaller`); feedback that arrives after the end is dropped.
+
+Waits: every wait takes a finite timeout and raises BridgeTimeout when it passes.
 
 Threads: every method is thread-safe (one lock). Waiting methods must not be called on the
 thread that finishes the goal (for `ActionCaller`: never on the ROS thread).
@@ -122,10 +132,14 @@ class ActionGoal:
     # --- waiting (never on the thread that finishes the goal) ---
 
     def wait_accepted(self, timeout_s: float = 10.0) -> None:
-        """Return once the robot side accepted the goal; raise GoalRejected if it refused it,
-        BridgeTimeout if no answer came within `timeout_s`, or the goal's exception."""
-        if not self._acceptance_known.wait(timeout_s):
-            raise BridgeTimeout(f"{self.action_name}: no answer to the goal request within {timeout_s:.1f} s")
+        """Return once the robot side accepted the goal; raise GoalRejected if it refused it, or the
+        goal's exception. If no answer came within `timeout_s`, the goal is withdrawn (see
+        `withdraw`: cancelled should the robot side accept it later) and BridgeTimeout raised."""
+        if not self._acceptance_known.wait(_finite(timeout_s)):
+            self.withdraw(f"no answer to the goal request within {timeout_s:.1f} s")
+            withdrawn = self.exception()
+            if withdrawn is not None:
+                raise withdrawn
         with self._lock:
             accepted, error = self._accepted, self._exception
         if accepted is None and error is not None:
@@ -133,25 +147,24 @@ class ActionGoal:
         if not accepted:
             raise GoalRejected(f"{self.action_name}: the action server rejected the goal")
 
-    def wait(self, timeout_s: float | None = None) -> None:
+    def wait(self, timeout_s: float) -> None:
         """Return once the goal has finished with an outcome (successful or not); raise its
         exception if it ended with one, BridgeTimeout if it is still running after `timeout_s`."""
-        if not self._finished.wait(timeout_s):
-            assert timeout_s is not None
+        if not self._finished.wait(_finite(timeout_s)):
             raise BridgeTimeout(f"{self.action_name}: no result within {timeout_s:.1f} s")
         if self._exception is not None:
             raise self._exception
 
-    def result(self, timeout_s: float | None = None) -> ActionOutcome:
+    def result(self, timeout_s: float) -> ActionOutcome:
         """`wait(timeout_s)`, then the outcome. A rejected goal is an unsuccessful outcome."""
         self.wait(timeout_s)
         assert self._outcome is not None  # finished without an exception
         return self._outcome
 
-    def exception(self, timeout_s: float | None = None) -> BridgeError | None:
-        """Wait for the end like `wait`; the exception the goal ended with, None if it was answered."""
-        if not self._finished.wait(timeout_s):
-            assert timeout_s is not None
+    def exception(self, timeout_s: float = 0.0) -> BridgeError | None:
+        """Wait for the end like `wait` (by default not at all: for a goal known to have ended);
+        the exception the goal ended with, None if it was answered."""
+        if not self._finished.wait(_finite(timeout_s)):
             raise BridgeTimeout(f"{self.action_name}: not finished within {timeout_s:.1f} s")
         return self._exception
 
@@ -231,6 +244,26 @@ class ActionGoal:
         supervisor; sends nothing to the robot side. False if the goal had already finished."""
         return self.set_exception(GoalAbandoned(f"{self.action_name}: {reason}"))
 
+    def withdraw(self, reason: str, cancel_timeout_s: float = 5.0) -> bool:
+        """Give the goal up before it was accepted: finish it with BridgeTimeout(`reason`), so
+        feedback and a result that still come are dropped, and ask the creator to cancel it: at
+        once if the robot side accepted it meanwhile (waiting up to `cancel_timeout_s` for the
+        request to go out), else as soon as a late acceptance arrives. False, doing nothing, if
+        the goal had already finished."""
+        if self.done:
+            return False
+        if self._cancel_request is not None:
+            try:
+                self._cancel_request(cancel_timeout_s)
+            except BridgeError as cancel_error:
+                logger.warning("%s: cancelling the withdrawn goal failed: %s", self.action_name, cancel_error)
+        return self.set_exception(
+            BridgeTimeout(
+                f"{self.action_name}: {reason}; the goal was withdrawn (cancelled should the robot side "
+                "accept it later)"
+            )
+        )
+
     # --- helpers ---
 
     def _finish(
@@ -274,3 +307,10 @@ class ActionGoal:
             else:
                 state = {None: "pending", True: "accepted", False: "rejected"}[self._accepted]
         return f"ActionGoal({self.action_name}, {state}, progress={self._progress.progress:.2f})"
+
+
+def _finite(timeout_s: float) -> float:
+    """A wait's bound: a number of seconds, never None (which would wait forever)."""
+    if timeout_s is None:
+        raise TypeError("a wait on a goal needs a timeout in seconds, not None")
+    return max(0.0, float(timeout_s))

@@ -5,14 +5,20 @@ contract (/navigate_to_poi, /get_labware, /robot_state, ...) and converts messag
 plain snapshots of `workcell.py`. It knows nothing of the simulation: a real robot that serves
 the same names works unchanged.
 
+Its ROS endpoints (action and service clients, topic mirrors) live on one `RosRuntime`; `attach`
+moves the link to a new runtime when the old one's ROS thread has died, keeping the link object,
+its listeners and its last state, so everything built on it (controllers, SiLA features) goes on.
+
 Threads: construct and call from any thread except the ROS thread; every wait is on a future
-with a timeout. Listeners registered here run on the ROS thread.
+with a timeout. Listeners registered here run on the ROS thread (on the supervisor's thread for
+`mark_robot_side_lost` when the ROS thread is gone).
 """
 
 from __future__ import annotations
 
 import logging
 from collections.abc import Callable
+from dataclasses import dataclass
 
 from labware_interfaces.action import Dock, GetLabware, NavigateToPoi, PutLabware, Undock
 from labware_interfaces.msg import RobotState, StationStates
@@ -57,6 +63,42 @@ def nest_readings_from_message(message: StationStates) -> tuple[NestReading, ...
     )
 
 
+@dataclass(frozen=True)
+class _Endpoints:
+    """The link's clients and mirrors on one runtime; replaced as a whole by `RobotLink.attach`."""
+
+    runtime: RosRuntime
+    navigate: ActionCaller
+    dock: ActionCaller
+    undock: ActionCaller
+    get_labware: ActionCaller
+    put_labware: ActionCaller
+    describe: ServiceCaller
+    check_placement: ServiceCaller
+    robot_state: TopicMirror
+    station_states: TopicMirror
+
+    @classmethod
+    def create(
+        cls,
+        runtime: RosRuntime,
+        on_robot_state: Callable[[RobotState], None],
+        on_station_states: Callable[[StationStates], None],
+    ) -> _Endpoints:
+        return cls(
+            runtime,
+            ActionCaller(runtime, NavigateToPoi, "/navigate_to_poi"),
+            ActionCaller(runtime, Dock, "/dock"),
+            ActionCaller(runtime, Undock, "/undock"),
+            ActionCaller(runtime, GetLabware, "/get_labware"),
+            ActionCaller(runtime, PutLabware, "/put_labware"),
+            ServiceCaller(runtime, DescribeWorkcell, "/describe_workcell"),
+            ServiceCaller(runtime, CheckPlacement, "/check_placement"),
+            TopicMirror(runtime, RobotState, "/robot_state", listeners=[on_robot_state]),
+            TopicMirror(runtime, StationStates, "/station_states", listeners=[on_station_states]),
+        )
+
+
 class RobotLink:
     """Clients of every robot-side action, service and topic, sharing one `RosRuntime`.
 
@@ -64,53 +106,68 @@ class RobotLink:
     tests); that protocol's docstrings state the units, errors and threads of the methods it names."""
 
     def __init__(self, runtime: RosRuntime) -> None:
-        self.runtime = runtime
-        self._navigate = ActionCaller(runtime, NavigateToPoi, "/navigate_to_poi")
-        self._dock = ActionCaller(runtime, Dock, "/dock")
-        self._undock = ActionCaller(runtime, Undock, "/undock")
-        self._get_labware = ActionCaller(runtime, GetLabware, "/get_labware")
-        self._put_labware = ActionCaller(runtime, PutLabware, "/put_labware")
-        self._describe = ServiceCaller(runtime, DescribeWorkcell, "/describe_workcell")
-        self._check_placement = ServiceCaller(runtime, CheckPlacement, "/check_placement")
-        self._robot_state = TopicMirror(runtime, RobotState, "/robot_state")
-        self._station_states = TopicMirror(runtime, StationStates, "/station_states")
+        self._status_listeners: list[Callable[[RobotStatus], None]] = []
+        self._nest_listeners: list[Callable[[tuple[NestReading, ...]], None]] = []
+        self._ros = _Endpoints.create(runtime, self._tell_status_listeners, self._tell_nest_listeners)
+
+    @property
+    def runtime(self) -> RosRuntime:
+        """The runtime the link's endpoints live on now."""
+        return self._ros.runtime
+
+    def attach(self, runtime: RosRuntime) -> None:
+        """Rebuild every endpoint on `runtime` (started), for a link whose runtime died: listeners
+        stay registered, and the last robot state and nest readings are carried over until the new
+        robot side publishes. The old runtime's entities are its own to destroy (`stop()`)."""
+        previous = self._ros
+        endpoints = _Endpoints.create(runtime, self._tell_status_listeners, self._tell_nest_listeners)
+        for old, new in (
+            (previous.robot_state, endpoints.robot_state),
+            (previous.station_states, endpoints.station_states),
+        ):
+            last = old.latest
+            if last is not None:  # on the ROS thread: no real message can come in between
+                runtime.call(lambda mirror=new, message=last: _inject_unless_received(mirror, message))
+        self._ros = endpoints
+        logger.info("robot link attached to a new ROS runtime")
 
     def wait_until_ready(self, timeout_s: float = 30.0) -> None:
         """Wait for every action server, service and state topic; raise ServerUnavailable naming one."""
-        for action in (self._navigate, self._dock, self._undock, self._get_labware, self._put_labware):
+        ros = self._ros
+        for action in (ros.navigate, ros.dock, ros.undock, ros.get_labware, ros.put_labware):
             action.wait_for_server(timeout_s)
-        for service in (self._describe, self._check_placement):
+        for service in (ros.describe, ros.check_placement):
             service.wait_for_service(timeout_s)
-        self._robot_state.wait_for_message(timeout_s)
-        self._station_states.wait_for_message(timeout_s)
+        ros.robot_state.wait_for_message(timeout_s)
+        ros.station_states.wait_for_message(timeout_s)
 
     # --- actions: each returns a goal handle at once (wait on it, cancel it) ---
 
     def navigate_to_poi(self, poi: str, on_feedback: FeedbackListener | None = None) -> ActionGoal:
-        return self._navigate.send(NavigateToPoi.Goal(poi=poi), on_feedback)
+        return self._ros.navigate.send(NavigateToPoi.Goal(poi=poi), on_feedback)
 
     def dock(self, on_feedback: FeedbackListener | None = None) -> ActionGoal:
-        return self._dock.send(Dock.Goal(), on_feedback)
+        return self._ros.dock.send(Dock.Goal(), on_feedback)
 
     def undock(self, on_feedback: FeedbackListener | None = None) -> ActionGoal:
-        return self._undock.send(Undock.Goal(), on_feedback)
+        return self._ros.undock.send(Undock.Goal(), on_feedback)
 
     def get_labware(
         self, handover: LabwareHandover, on_feedback: FeedbackListener | None = None
     ) -> ActionGoal:
         """Take the plate from the station nest into the hotel slot."""
-        return self._get_labware.send(handover.goal(GetLabware.Goal), on_feedback)
+        return self._ros.get_labware.send(handover.goal(GetLabware.Goal), on_feedback)
 
     def put_labware(
         self, handover: LabwareHandover, on_feedback: FeedbackListener | None = None
     ) -> ActionGoal:
         """Place the plate of the hotel slot into the station nest."""
-        return self._put_labware.send(handover.goal(PutLabware.Goal), on_feedback)
+        return self._ros.put_labware.send(handover.goal(PutLabware.Goal), on_feedback)
 
     # --- services ---
 
     def describe_workcell(self, timeout_s: float = 5.0) -> WorkcellDescription:
-        response = self._describe.call(DescribeWorkcell.Request(), timeout_s)
+        response = self._ros.describe.call(DescribeWorkcell.Request(), timeout_s)
         return WorkcellDescription(
             stations=tuple(
                 StationDescription(station.name, int(station.sub_positions), station.poi)
@@ -131,7 +188,7 @@ class RobotLink:
         request = CheckPlacement.Request(labware_id=labware_id)
         if nest is not None:
             request.station, request.sub_position = nest.station, nest.sub_position
-        response = self._check_placement.call(request, timeout_s)
+        response = self._ros.check_placement.call(request, timeout_s)
         try:
             location = parse_location(response.location)
         except ValueError as error:
@@ -149,20 +206,20 @@ class RobotLink:
 
     def robot_status(self, timeout_s: float = 5.0) -> RobotStatus:
         """The latest robot state (waits for the first message up to `timeout_s`)."""
-        return robot_status_from_message(self._robot_state.wait_for_message(timeout_s))
+        return robot_status_from_message(self._ros.robot_state.wait_for_message(timeout_s))
 
     def latest_robot_status(self) -> RobotStatus | None:
-        message = self._robot_state.latest
+        message = self._ros.robot_state.latest
         return None if message is None else robot_status_from_message(message)
 
     def nest_readings(self, timeout_s: float = 5.0) -> tuple[NestReading, ...]:
         """The latest sensor reading of every nest (waits for the first message up to `timeout_s`)."""
-        return nest_readings_from_message(self._station_states.wait_for_message(timeout_s))
+        return nest_readings_from_message(self._ros.station_states.wait_for_message(timeout_s))
 
     def wait_for_robot_status(
         self, predicate: Callable[[RobotStatus], bool], timeout_s: float = 5.0
     ) -> RobotStatus:
-        message = self._robot_state.wait_for_message(
+        message = self._ros.robot_state.wait_for_message(
             timeout_s, lambda message: predicate(robot_status_from_message(message))
         )
         return robot_status_from_message(message)
@@ -178,19 +235,46 @@ class RobotLink:
                 for state in message.nests
             )
 
-        self._station_states.wait_for_message(timeout_s, matches)
+        self._ros.station_states.wait_for_message(timeout_s, matches)
 
     def on_robot_status(self, listener: Callable[[RobotStatus], None]) -> None:
         """Call `listener(status)` on every change of /robot_state (on the ROS thread)."""
-        self._robot_state.add_listener(lambda message: listener(robot_status_from_message(message)))
+        self._status_listeners.append(listener)
 
     def mark_robot_side_lost(self, reason: str) -> None:
         """Show locally that the robot side is gone: state "error" with `reason`, nothing observed
         aboard (a dead robot side reports nothing). Listeners see it like a received message;
-        the next real /robot_state replaces it. Used by the deployment's supervisor."""
+        the next real /robot_state replaces it. Used by the deployment's supervisor; works also when
+        the ROS thread is gone (then the listeners run on the calling thread)."""
         message = RobotState(state=RobotState.STATE_ERROR, detail=reason)
-        self.runtime.call(lambda: self._robot_state._on_message(message))
+        ros = self._ros
+        try:
+            ros.runtime.call(lambda: ros.robot_state.inject(message))
+        except BridgeError:  # no ROS thread to deliver it: nobody else calls the listeners now
+            ros.robot_state.inject(message)
 
     def on_nest_readings(self, listener: Callable[[tuple[NestReading, ...]], None]) -> None:
         """Call `listener(readings)` on every change of /station_states (on the ROS thread)."""
-        self._station_states.add_listener(lambda message: listener(nest_readings_from_message(message)))
+        self._nest_listeners.append(listener)
+
+    def _tell_status_listeners(self, message: RobotState) -> None:
+        status = robot_status_from_message(message)
+        for listener in list(self._status_listeners):
+            _tell(listener, status, "/robot_state")
+
+    def _tell_nest_listeners(self, message: StationStates) -> None:
+        readings = nest_readings_from_message(message)
+        for listener in list(self._nest_listeners):
+            _tell(listener, readings, "/station_states")
+
+
+def _inject_unless_received(mirror: TopicMirror, message: object) -> None:
+    if mirror.latest is None:
+        mirror.inject(message)
+
+
+def _tell(listener: Callable[[object], None], value: object, topic: str) -> None:
+    try:
+        listener(value)
+    except Exception:  # noqa: BLE001 - one broken listener must not keep the others uninformed
+        logger.exception("a listener of %s failed", topic)

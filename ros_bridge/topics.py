@@ -14,7 +14,7 @@ from __future__ import annotations
 import logging
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any, Generic, TypeVar
 
 from rclpy.qos import QoSDurabilityPolicy, QoSHistoryPolicy, QoSProfile, QoSReliabilityPolicy
@@ -51,7 +51,10 @@ class TopicMirror(Generic[M]):
         topic: str,
         qos: QoSProfile = STATE_QOS,
         key: Callable[[M], Any] = message_without_stamp,
+        listeners: Sequence[Callable[[M], None]] = (),
     ) -> None:
+        """Subscribe to `topic`; `listeners` hear from the first message on (one added later with
+        `add_listener` may miss a message that came before it)."""
         self.topic = topic
         self._runtime = runtime
         self._key = key
@@ -59,7 +62,7 @@ class TopicMirror(Generic[M]):
         self._latest: M | None = None
         self._latest_key: Any = None
         self._received_count = 0
-        self._listeners: list[Callable[[M], None]] = []
+        self._listeners: list[Callable[[M], None]] = list(listeners)
         self._subscription = runtime.call(
             lambda: runtime.node.create_subscription(message_type, topic, self._on_message, qos)
         )
@@ -95,6 +98,12 @@ class TopicMirror(Generic[M]):
     def destroy(self) -> None:
         if self._runtime.running:
             self._runtime.call(lambda: self._runtime.node.destroy_subscription(self._subscription))
+
+    def inject(self, message: M) -> None:
+        """Take `message` as if it had been received (local knowledge, such as "the robot side is
+        gone"); the next real message replaces it. Listeners run on the calling thread: call this on
+        the ROS thread while the runtime runs."""
+        self._on_message(message)
 
     def _on_message(self, message: M) -> None:
         """Listeners first, then waiters: whoever returns from `wait_for_message` with this message

@@ -5,7 +5,16 @@
     sila-labware bench --trials N --seed S [--json] [--report DIR] [--replay SEED] [levels] (bench_cli)
     sila-labware bluesky-demo --world FILE   (the same robot driven from a Bluesky RunEngine plan)
 
-Exit codes: 0 success, 1 the demo transfer failed or the stack could not start, 2 bad usage.
+Exit codes: 0 success, 1 the demo transfer failed or the stack could not start, 2 bad usage,
+130 `demo` or `bench` stopped by Ctrl-C or SIGTERM.
+
+Stopping and clean-up: Ctrl-C (or SIGTERM) stops `serve`, `demo` and `bench` at any point, start-up
+included, within 5 s: the running transfer is abandoned (the robot is told to stop), the SiLA
+servers, the bridge and the robot side's processes (in their own sessions, so a terminal's Ctrl-C
+never reaches them) are stopped, and a second Ctrl-C does not cut that short. What a run creates
+in the temp folder (the `sila-labware-demo-*` / `sila-labware-bench-*` directory holding the run's
+CA file) is removed on success, failure and Ctrl-C. `demo --json` always prints one JSON object,
+with `success: false` and `error` when start-up failed or the run was stopped.
 """
 
 from __future__ import annotations
@@ -17,22 +26,24 @@ import signal
 import sys
 import tempfile
 import threading
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 from types import FrameType
 from typing import TYPE_CHECKING
 
 from sila_labware.benchmarks.campaign_cli import (
+    INTERRUPTED_EXIT_CODE,
     add_bench_arguments,
     bench_command,
-    temporary_ca_file,
     validate_bench,
     write_recorded_pictures,
 )
 from sila_labware.servers.refusal_log import install_refusal_log_filter
 
 if TYPE_CHECKING:
-    from sila_labware.deployment.stack import Deployment
+    from sila_labware.deployment.demo import DemoReport
+    from sila_labware.deployment.stack import Deployment, DeploymentOptions
 
 logger = logging.getLogger("sila_labware")
 
@@ -75,7 +86,8 @@ def build_parser() -> argparse.ArgumentParser:
             type=Path,
             default=None,
             help="where to write the CA certificate clients trust "
-            "(default: ./sila-labware-ca.pem for serve, a temporary file for demo)",
+            "(default: ./sila-labware-ca.pem for serve; for demo and bench a temporary file, "
+            "removed at the end)",
         )
         sub.add_argument("--no-discovery", action="store_true", help="do not announce the servers (mDNS)")
         sub.add_argument(
@@ -153,26 +165,24 @@ class _StopRequest:
         self.event.set()
 
 
-def _deployment_from(args: argparse.Namespace):
-    from sila_labware.deployment.stack import Deployment, DeploymentOptions
+def _deployment_options(args: argparse.Namespace, ca_file: Path) -> DeploymentOptions:
+    from sila_labware.deployment.stack import DeploymentOptions
 
     if args.insecure:
         logger.warning(
             "serving WITHOUT encryption (--insecure): for tests only, the SiLA standard forbids it"
         )
-    return Deployment(
-        DeploymentOptions(
-            world=args.world,
-            host=args.host,
-            port_base=args.port_base,
-            insecure=args.insecure,
-            ca_file=_ca_file(args),
-            discovery=not args.no_discovery,
-            domain_id=args.domain_id,
-            ready_timeout_s=args.ready_timeout,
-            log_dir=args.log_dir,
-            extra_sim_arguments=_record_arguments(args),
-        )
+    return DeploymentOptions(
+        world=args.world,
+        host=args.host,
+        port_base=args.port_base,
+        insecure=args.insecure,
+        ca_file=ca_file,
+        discovery=not args.no_discovery,
+        domain_id=args.domain_id,
+        ready_timeout_s=args.ready_timeout,
+        log_dir=args.log_dir,
+        extra_sim_arguments=_record_arguments(args),
     )
 
 
@@ -181,14 +191,24 @@ def _record_arguments(args: argparse.Namespace) -> list[str]:
     return [] if record is None else ["--record-dir", str(record / "frames")]
 
 
-def _ca_file(args: argparse.Namespace) -> Path:
-    if args.ca_file is not None:
-        return args.ca_file
-    if args.command == "bench":
-        return temporary_ca_file()
-    if args.command == "demo":
-        return Path(tempfile.mkdtemp(prefix="sila-labware-demo-")) / "ca.pem"
-    return Path("sila-labware-ca.pem")
+@contextmanager
+def _ca_file(args: argparse.Namespace) -> Iterator[Path]:
+    """Where the run writes the CA certificate: --ca-file, ./sila-labware-ca.pem for serve, else a
+    `sila-labware-<command>-*` directory in the temp folder, removed when the block ends (however)."""
+    if args.ca_file is not None or args.command == "serve":
+        yield args.ca_file or Path("sila-labware-ca.pem")
+        return
+    with tempfile.TemporaryDirectory(prefix=f"sila-labware-{args.command}-") as scratch:
+        yield Path(scratch) / "ca.pem"
+
+
+def _interrupt_on_signals() -> None:
+    """SIGINT and SIGTERM raise KeyboardInterrupt on the main thread, except while interrupts are
+    held (a child being started, a deployment stopping): the run unwinds through its clean-up."""
+    from sila_labware.deployment.processes import interrupt_between_starts
+
+    signal.signal(signal.SIGINT, interrupt_between_starts)
+    signal.signal(signal.SIGTERM, interrupt_between_starts)
 
 
 def _print_servers(deployment, stream) -> None:
@@ -205,9 +225,11 @@ def _print_servers(deployment, stream) -> None:
 def _start(args: argparse.Namespace) -> tuple[Deployment | None, _StopRequest]:
     """Start the deployment; None if it could not start (the reason is on stderr) or was stopped
     while starting (then the stop request is set)."""
+    from sila_labware.deployment.stack import Deployment
+
     stop = _StopRequest()
     stop.install()
-    deployment = _deployment_from(args)
+    deployment = Deployment(_deployment_options(args, args.ca_file or Path("sila-labware-ca.pem")))
     try:
         deployment.start(should_stop=stop.event.is_set)
     except KeyboardInterrupt:
@@ -239,28 +261,64 @@ def serve(args: argparse.Namespace) -> int:
 
 
 def demo(args: argparse.Namespace) -> int:
-    from sila_labware.deployment.demo import run_demo
-
-    deployment, _stop = _start(args)
-    if deployment is None:
-        return 1
-    try:
-        _print_servers(deployment, sys.stderr)
-        report = run_demo(deployment, progress_stream=sys.stderr)
-    finally:
-        deployment.stop()
-    if args.record is not None:
-        write_recorded_pictures(args.record)
+    _interrupt_on_signals()
+    with _ca_file(args) as ca_file:
+        report, ending = _run_demo(args, ca_file)
+    if args.record is not None and ending == _TRANSFERRED:
+        try:
+            write_recorded_pictures(args.record)
+        except KeyboardInterrupt:
+            ending = _INTERRUPTED
+    for stop_signal in (signal.SIGINT, signal.SIGTERM):  # the outcome is printed whole
+        signal.signal(stop_signal, signal.SIG_IGN)
     if args.json:
         sys.stdout.write(json.dumps(report.as_json_object()) + "\n")
-    else:
+    elif ending != _NOT_STARTED:  # a start-up failure is the one line on stderr
         outcome = "plate delivered" if report.success else f"FAILED: {report.error}"
         error_mm = report.plate_position_error_mm
         detail = f" (position error {error_mm:.1f} mm)" if error_mm is not None else ""
         sys.stdout.write(
             f"{outcome}{detail}; {report.wall_seconds:.1f} s wall, {report.sim_seconds:.1f} s simulated\n"
         )
+    sys.stdout.flush()
+    if ending == _INTERRUPTED:
+        return INTERRUPTED_EXIT_CODE
     return 0 if report.success else 1
+
+
+_TRANSFERRED, _INTERRUPTED, _NOT_STARTED = "transferred", "interrupted", "not started"
+
+
+def _run_demo(args: argparse.Namespace, ca_file: Path) -> tuple[DemoReport, str]:
+    """Start, transfer, stop: the report (with the error of whatever failed) and how it ended
+    (_TRANSFERRED: the transfer ran, successful or not). Never raises for a failure or an
+    interrupt; always stops what it started."""
+    from sila_labware.deployment.demo import DemoReport, run_demo
+    from sila_labware.deployment.processes import interrupt_requested
+    from sila_labware.deployment.stack import Deployment
+
+    report, deployment, ending = DemoReport(), None, _NOT_STARTED
+    try:
+        deployment = Deployment(_deployment_options(args, ca_file))
+        deployment.start()
+        ending = _TRANSFERRED
+        _print_servers(deployment, sys.stderr)
+        report = run_demo(deployment, progress_stream=sys.stderr)
+        if interrupt_requested():  # a library turned the KeyboardInterrupt into its own error
+            raise KeyboardInterrupt
+    except KeyboardInterrupt:
+        ending = _INTERRUPTED
+        report.success = False
+        report.error = "interrupted (SIGINT or SIGTERM): the transfer was abandoned and everything stopped"
+        sys.stderr.write(f"\nsila-labware: {report.error}\n")
+    except Exception as error:  # noqa: BLE001 - one line for the user, details in the log
+        logger.debug("demo failed", exc_info=True)
+        report.error = f"{'demo failed' if ending == _TRANSFERRED else 'could not start'}: {error}"
+        sys.stderr.write(f"sila-labware: {report.error}\n")
+    finally:
+        if deployment is not None:
+            deployment.stop()
+    return report, ending
 
 
 def bluesky_demo(args: argparse.Namespace) -> int:
@@ -280,13 +338,11 @@ def bluesky_demo(args: argparse.Namespace) -> int:
 
 
 def _bench(args: argparse.Namespace) -> int:
-    from sila_labware.deployment.processes import interrupt_between_starts
-
     # Ctrl-C and SIGTERM unwind the running trial: its robot side (own sessions, so a terminal's
     # Ctrl-C never reaches it) is stopped on the way out instead of being left running.
-    signal.signal(signal.SIGINT, interrupt_between_starts)
-    signal.signal(signal.SIGTERM, interrupt_between_starts)
-    return bench_command(args, _deployment_from(args).options)
+    _interrupt_on_signals()
+    with _ca_file(args) as ca_file:
+        return bench_command(args, _deployment_options(args, ca_file))
 
 
 COMMANDS = {"serve": serve, "demo": demo, "bluesky-demo": bluesky_demo, "bench": _bench}
@@ -305,7 +361,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.command == "bluesky-demo":
         # bluesky's own loggers report every state change at INFO
         logging.getLogger("bluesky").setLevel(logging.INFO if args.verbose else logging.WARNING)
-    return COMMANDS[args.command](args)
+    try:
+        return COMMANDS[args.command](args)
+    except KeyboardInterrupt:  # a further Ctrl-C after the run was stopped and cleaned up
+        return INTERRUPTED_EXIT_CODE
 
 
 if __name__ == "__main__":

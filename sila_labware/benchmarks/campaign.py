@@ -29,6 +29,7 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from sila_labware.deployment.demo import MISPLACED, DemoReport, run_demo
+from sila_labware.deployment.processes import interrupt_requested
 from sila_labware.deployment.stack import Deployment, DeploymentOptions
 
 logger = logging.getLogger(__name__)
@@ -201,6 +202,8 @@ def run_campaign(
         record_dir = options.record_dir if index == 0 else None
         try:
             outcome = run_trial(options, trial_seed, record_dir)
+            if interrupt_requested():  # a library turned the KeyboardInterrupt into its own error
+                raise KeyboardInterrupt
         except KeyboardInterrupt:
             logger.warning(
                 "interrupted: trial seed %d abandoned, %d of %d trial(s) done",

@@ -13,7 +13,6 @@ import argparse
 import json
 import logging
 import sys
-import tempfile
 from dataclasses import asdict
 from pathlib import Path
 
@@ -117,10 +116,6 @@ def bench_command(args: argparse.Namespace, stack: DeploymentOptions) -> int:
     if interrupted:
         return INTERRUPTED_EXIT_CODE
     return 0 if summary["successes"] == summary["trials"] else 1
-
-
-def temporary_ca_file() -> Path:
-    return Path(tempfile.mkdtemp(prefix="sila-labware-bench-")) / "ca.pem"
 
 
 def write_recorded_pictures(record_dir: Path) -> None:

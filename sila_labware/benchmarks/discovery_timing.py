@@ -22,6 +22,8 @@ from pathlib import Path
 
 from zeroconf import ServiceBrowser, ServiceListener, Zeroconf
 
+from sila_labware.benchmarks.child_lines import ChildLines
+
 logger = logging.getLogger(__name__)
 
 SILA_SERVICE_TYPE = "_sila._tcp.local."
@@ -64,7 +66,8 @@ class _PortListener(ServiceListener):
 def time_serve_until_discoverable(
     world: Path, port_base: int, ca_file: Path, timeout_s: float = 180.0
 ) -> DiscoveryTiming:
-    """Launch `serve` (TLS, discovery on), wait until all its servers are discoverable, stop it."""
+    """Launch `serve` (TLS, discovery on), wait until all its servers are discoverable, stop it.
+    RuntimeError (ChildSilent, a TimeoutError, if `serve` says nothing) after `timeout_s`."""
     zeroconf = Zeroconf()
     listener = _PortListener()
     browser = ServiceBrowser(zeroconf, SILA_SERVICE_TYPE, listener)
@@ -96,15 +99,14 @@ def _read_server_ports(
 ) -> tuple[list[int], float]:
     """The ports `serve` lists, and when it finished listing them (the "serving" line)."""
     assert serve.stdout is not None
+    lines = ChildLines(serve.stdout, "serve")
     ports: list[int] = []
-    for line in serve.stdout:
+    while (line := lines.next_line(started + timeout_s - time.monotonic())) is not None:
         match = SERVER_LINE.match(line.strip())
         if match:
             ports.append(int(match.group(3)))
         if line.startswith("serving"):
             return ports, time.monotonic() - started
-        if time.monotonic() - started > timeout_s:
-            break
     raise RuntimeError(f"serve did not report its servers (exit code {serve.poll()})")
 
 
@@ -115,6 +117,6 @@ def _stop(serve: subprocess.Popen[str]) -> None:
             serve.wait(timeout=10.0)
         except subprocess.TimeoutExpired:
             serve.kill()
-            serve.wait()
+            serve.wait(timeout=10.0)
     if serve.stdout is not None:
         serve.stdout.close()

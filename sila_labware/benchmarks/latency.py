@@ -24,11 +24,9 @@ import asyncio
 import json
 import logging
 import math
-import queue
 import subprocess
 import sys
 import tempfile
-import threading
 import time
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, replace
@@ -45,6 +43,7 @@ from ros_bridge.latency_peer import STATION_POI
 from ros_bridge.robot_link import RobotLink
 from ros_bridge.runtime import RosRuntime
 from ros_bridge.services import ServiceCaller
+from sila_labware.benchmarks.child_lines import ChildLines, ChildSilent
 from sila_labware.benchmarks.discovery_timing import time_serve_until_discoverable
 from sila_labware.deployment.processes import ros_environment
 from sila_labware.deployment.stack import join_ros_domain
@@ -55,6 +54,7 @@ from sila_labware.servers.serving import start_sila_server
 logger = logging.getLogger(__name__)
 
 DEFAULT_WORLD = Path(__file__).resolve().parents[2] / "tiago_sim" / "worlds" / "default.yaml"
+PEER_START_TIMEOUT_S = 60.0
 
 
 @dataclass(frozen=True)
@@ -99,7 +99,7 @@ def percentiles(seconds: Sequence[float]) -> Percentiles:
 
 
 class _Peer:
-    """The latency peer child; its per-goal JSON lines arrive in a queue."""
+    """The latency peer child; its per-goal JSON lines are read as they come, each with a bound."""
 
     def __init__(self, domain_id: int, feedbacks: int) -> None:
         command = [sys.executable, "-m", "ros_bridge.latency_peer", "--feedbacks", str(feedbacks)]
@@ -107,19 +107,20 @@ class _Peer:
             command, stdout=subprocess.PIPE, text=True, env=ros_environment(domain_id)
         )
         assert self.process.stdout is not None
-        if self.process.stdout.readline().strip() != "READY":
+        self._lines = ChildLines(self.process.stdout, "the latency peer")
+        try:
+            ready = self._lines.next_line(PEER_START_TIMEOUT_S)
+        except ChildSilent:
+            ready = None
+        if ready is None or ready.strip() != "READY":
             self.stop()
-            raise RuntimeError("latency peer did not start")
-        self.goals: queue.Queue[dict[str, Any]] = queue.Queue()
-        threading.Thread(target=self._read, daemon=True, name="latency-peer-reader").start()
-
-    def _read(self) -> None:
-        assert self.process.stdout is not None
-        for line in self.process.stdout:
-            self.goals.put(json.loads(line))
+            raise RuntimeError(f"latency peer did not start within {PEER_START_TIMEOUT_S:.0f} s")
 
     def next_goal(self, timeout_s: float = 10.0) -> dict[str, Any]:
-        return self.goals.get(timeout=timeout_s)
+        line = self._lines.next_line(timeout_s)
+        if line is None:
+            raise RuntimeError(f"the latency peer ended (exit code {self.process.poll()})")
+        return json.loads(line)
 
     def stop(self) -> None:
         self.process.terminate()
@@ -127,7 +128,7 @@ class _Peer:
             self.process.wait(timeout=5.0)
         except subprocess.TimeoutExpired:
             self.process.kill()
-            self.process.wait()
+            self.process.wait(timeout=5.0)
 
 
 def _feedback_delays(

@@ -25,6 +25,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from sila_labware.client.bounded import CALL_TIMEOUT_S, bounded
 from sila_labware.client.errors import StepTimeout, translate
 
 logger = logging.getLogger(__name__)
@@ -91,7 +92,7 @@ def run_step(
     failures: dict[int, Exception] = {}  # by the command's place in the step
     for index, command in enumerate(commands):
         try:
-            started.append((command, command.start()))
+            started.append((command, bounded(command.start, CALL_TIMEOUT_S, command.name)))
         except Exception as error:  # noqa: BLE001 - typed and raised below, after the others end
             failures[index] = _typed(error, command, step)
     try:
@@ -102,7 +103,7 @@ def run_step(
         raise
     for command, instance in started:
         try:
-            instance.get_responses()  # raises the command's SiLA error, if any
+            bounded(instance.get_responses, CALL_TIMEOUT_S, command.name)  # raises its SiLA error, if any
         except Exception as error:  # noqa: BLE001 - typed below
             failures[commands.index(command)] = _typed(error, command, step)
     if failures:

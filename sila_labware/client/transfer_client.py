@@ -34,6 +34,7 @@ from sila2.client import SilaClient
 from sila2.framework import SilaConnectionError
 
 from labware_model.holders import Nest
+from sila_labware.client.bounded import CALL_TIMEOUT_S, bounded
 from sila_labware.client.errors import LabwareTransferError, ParameterRejected, ServerUnreachable, translate
 from sila_labware.client.records import Address, Handover, HandoverPosition, LabwareLocation, OnboardLabware
 from sila_labware.client.sequence import StepPlan, pick_sequence, place_sequence
@@ -49,8 +50,10 @@ def connect(address: Address, root_certs: bytes | None, insecure: bool) -> SilaC
     host, port = address
     try:
         if insecure:
-            return SilaClient(host, port, insecure=True)
-        return SilaClient(host, port, root_certs=root_certs)
+            return bounded(lambda: SilaClient(host, port, insecure=True), CALL_TIMEOUT_S, f"{host}:{port}")
+        return bounded(
+            lambda: SilaClient(host, port, root_certs=root_certs), CALL_TIMEOUT_S, f"{host}:{port}"
+        )
     except (SilaConnectionError, OSError) as error:
         raise ServerUnreachable(f"no SiLA server answers at {host}:{port}: {error}") from error
 
@@ -338,9 +341,9 @@ class LabwareTransferClient:
 
     @staticmethod
     def _call(command: str, call: Callable[[], T]) -> T:
-        """An unobservable command or property read, its errors typed."""
+        """An unobservable command or property read, its errors typed, its wait bounded."""
         try:
-            return call()
+            return bounded(call, CALL_TIMEOUT_S, command)
         except Exception as error:  # noqa: BLE001 - typed and re-raised
             typed = translate(error, command=command)
             if typed is error:

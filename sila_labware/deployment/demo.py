@@ -5,7 +5,8 @@ Moves the plate found on the first station to a free nest of the second through
 Robot.PrepareForInput, Robot.GetLabware, A.LabwareRemoved, B.PrepareForInput +
 Robot.PrepareForOutput, Robot.PutLabware, B.LabwareDelivered). Each step is timed in wall and
 simulated seconds (the robot's /robot_state stamp, read through the bridge). Success is judged from
-physics ground truth (/check_placement through the bridge), never from what the commands reported.
+physics ground truth (/check_placement through the bridge), never from what the commands reported;
+a check that gets no answer makes the run a failure with that error, never a crash.
 
 Threads: runs on the caller's thread, where the client also calls back with progress; sila2's
 client threads deliver execution infos.
@@ -22,6 +23,7 @@ from typing import Any, TextIO
 
 from labware_model.holders import Nest, location_text
 from labware_model.readings import PlacementCheck
+from ros_bridge.errors import BridgeError
 from ros_bridge.robot_link import RobotLink
 from sila_labware.client import StepProgress
 from sila_labware.client.console import ProgressLine
@@ -29,6 +31,9 @@ from sila_labware.deployment.clients import transfer_client
 from sila_labware.deployment.stack import Deployment
 
 logger = logging.getLogger(__name__)
+
+PLACEMENT_CHECK_TIMEOUT_S = 10.0
+"""For /check_placement after the transfer (it answers in milliseconds on an idle robot side)."""
 
 
 @dataclass
@@ -88,7 +93,11 @@ def run_demo(deployment: Deployment, progress_stream: TextIO | None = sys.stderr
         report.error = "the world needs at least two stations"
         return report
     source, destination = stations[0], stations[1]
-    nests = link.nest_readings()
+    try:
+        nests = link.nest_readings()
+    except BridgeError as error:
+        report.error = f"the robot side reports no nest sensors: {error}"
+        return report
     plate_reading = next((n for n in nests if n.nest.station == source.name and n.occupied), None)
     free_reading = next((n for n in nests if n.nest.station == destination.name and not n.occupied), None)
     if plate_reading is None or free_reading is None:
@@ -118,8 +127,12 @@ def run_demo(deployment: Deployment, progress_stream: TextIO | None = sys.stderr
             progress_stream.write(f"\nfailed: {report.error}\n")
     report.steps = clock.steps
     report.wall_seconds = time.monotonic() - wall_start
-    report.sim_seconds = link.robot_status().stamp_s - sim_start
-    placement = link.check_placement(plate_id, free_nest)
+    try:
+        report.sim_seconds = link.robot_status().stamp_s - sim_start
+        placement = link.check_placement(plate_id, free_nest, timeout_s=PLACEMENT_CHECK_TIMEOUT_S)
+    except BridgeError as error:  # no ground truth: the transfer cannot count as delivered
+        report.error = report.error or f"physics check failed: no answer from the robot side: {error}"
+        return report
     report.success = placement.in_nest and not report.error
     if placement.found:
         report.plate_position_error_mm = 1000.0 * placement.position_error_m

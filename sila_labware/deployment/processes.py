@@ -18,8 +18,10 @@ import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from types import FrameType
@@ -43,6 +45,8 @@ INPUT_REFUSED_EXIT_CODE = 2
 as its last line of output; that line alone is the message (e.g. `sila-labware serve` shows it)."""
 
 LOG_TAIL_BYTES = 64 * 1024
+KILL_WAIT_S = 2.0
+"""How long `stop` waits for a child after SIGKILL."""
 
 
 class ChildExited(RuntimeError):
@@ -61,6 +65,10 @@ class Child:
     def running(self) -> bool:
         return self.popen.poll() is None
 
+    @property
+    def pid(self) -> int:
+        return self.popen.pid
+
     def log_tail(self, lines: int = 15) -> str:
         if self.log_path is not None and self.log_path.exists():
             text = self.log_path.read_text(errors="replace")
@@ -75,20 +83,50 @@ class Child:
         return "\n".join(text.splitlines()[-lines:])
 
 
-# Main thread only (signal handlers run there): an interrupt that arrives while a child is being
-# started is held until the child is registered, so the group's stop reaches it.
-_starting_child = False
+# Main thread only (signal handlers run there): an interrupt that arrives while interrupts are
+# held (a child being started, the deployment stopping) waits until the hold ends.
+_hold_depth = 0
 _interrupt_pending = False
+_interrupt_seen = False
 
 
 def interrupt_between_starts(_signum: int, _frame: FrameType | None) -> None:
-    """Signal handler raising KeyboardInterrupt, but never between starting a child (own session,
-    so no terminal signal reaches it) and registering it: that left a sequencer running."""
-    global _interrupt_pending
-    if _starting_child:
+    """Signal handler raising KeyboardInterrupt, but never while interrupts are held
+    (`interrupts_held`): between starting a child (own session, so no terminal signal reaches it)
+    and registering it, which left a sequencer running, or while a deployment stops."""
+    global _interrupt_pending, _interrupt_seen
+    _interrupt_seen = True
+    if _hold_depth:
         _interrupt_pending = True
         return
     raise KeyboardInterrupt
+
+
+def interrupt_requested() -> bool:
+    """True once `interrupt_between_starts` was called. Ask this after a run, not only whether
+    KeyboardInterrupt came out of it: a library may turn the exception into one of its own (the
+    sila2 client reports a call interrupted by it as ServerUnreachable)."""
+    return _interrupt_seen
+
+
+@contextmanager
+def interrupts_held() -> Iterator[None]:
+    """Hold `interrupt_between_starts` for the block; an interrupt that came meanwhile is raised as
+    KeyboardInterrupt when the block ends normally (if it raises, the interrupt stays pending until
+    the next hold ends). Does nothing on other threads than the main thread, which alone gets
+    signals."""
+    global _hold_depth, _interrupt_pending
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    _hold_depth += 1
+    try:
+        yield
+    finally:
+        _hold_depth -= 1
+    if _hold_depth == 0 and _interrupt_pending:
+        _interrupt_pending = False
+        raise KeyboardInterrupt
 
 
 class ProcessGroup:
@@ -110,27 +148,22 @@ class ProcessGroup:
             output = log_path.open("wb")
         else:
             output = output_file = tempfile.TemporaryFile(prefix=f"sila-labware-{name}-")
-        global _starting_child, _interrupt_pending
-        _starting_child = True
-        try:
-            popen = subprocess.Popen(
-                argv,
-                env=self._environment,
-                stdout=output,
-                stderr=subprocess.STDOUT,
-                stdin=subprocess.DEVNULL,
-                start_new_session=True,
-            )
-            child = Child(name, popen, log_path, output_file)
-            self.children.append(child)
-        finally:
-            _starting_child = False
-            if output_file is None:
-                output.close()  # the child holds its own descriptor
-        logger.info("started %s (pid %d): %s", name, popen.pid, " ".join(argv))
-        if _interrupt_pending:
-            _interrupt_pending = False
-            raise KeyboardInterrupt
+        with interrupts_held():
+            try:
+                popen = subprocess.Popen(
+                    argv,
+                    env=self._environment,
+                    stdout=output,
+                    stderr=subprocess.STDOUT,
+                    stdin=subprocess.DEVNULL,
+                    start_new_session=True,
+                )
+                child = Child(name, popen, log_path, output_file)
+                self.children.append(child)
+            finally:
+                if output_file is None:
+                    output.close()  # the child holds its own descriptor
+            logger.info("started %s (pid %d): %s", name, popen.pid, " ".join(argv))
         return child
 
     def check_running(self) -> None:
@@ -146,10 +179,14 @@ class ProcessGroup:
                     + (f"; last lines of its log:\n{tail}" if tail else "")
                 )
 
+    def terminate(self) -> None:
+        """SIGTERM every child's process group and return at once (`stop` waits for them)."""
+        for child in list(self.children):
+            _signal_group(child, signal.SIGTERM)
+
     def stop(self, timeout_s: float = 3.0) -> None:
         """SIGTERM every child's process group, wait up to `timeout_s`, then SIGKILL the rest."""
-        for child in self.children:
-            _signal_group(child, signal.SIGTERM)
+        self.terminate()
         deadline = time.monotonic() + timeout_s
         for child in self.children:
             try:
@@ -157,7 +194,12 @@ class ProcessGroup:
             except subprocess.TimeoutExpired:
                 logger.warning("%s did not stop on SIGTERM within %.1f s: killing it", child.name, timeout_s)
                 _signal_group(child, signal.SIGKILL)
-                child.popen.wait(2.0)
+                try:
+                    child.popen.wait(KILL_WAIT_S)
+                except subprocess.TimeoutExpired:  # stuck in the kernel: nothing more to do here
+                    logger.error(
+                        "%s (pid %d) survived SIGKILL for %.1f s", child.name, child.pid, KILL_WAIT_S
+                    )
         for child in self.children:
             if child.output_file is not None:
                 child.output_file.close()

@@ -4,8 +4,12 @@ Order of start: the robot side as child processes (simulation node, task sequenc
 ROS runtime in this process, a wait until every ROS server answers, then one SiLA server for the
 robot and one per station the robot side describes. `stop()` undoes it in reverse, quickly.
 
-Threads: `start`/`stop` run on the caller's thread; the bridge adds one ROS thread; each SiLA
-server has its own gRPC thread pool.
+Restarts: the supervisor (supervisor.py) restarts the robot side, and puts the bridge's link on a
+new ROS runtime when the ROS thread died. Both go through this class, under one lock, and are
+refused once `stop()` has begun, so that nothing is started behind a stop.
+
+Threads: `start`/`stop` run on the caller's thread; restarts on the supervisor's thread; the
+bridge adds one ROS thread; each SiLA server has its own gRPC thread pool.
 """
 
 from __future__ import annotations
@@ -25,7 +29,7 @@ from ros_bridge.domain import reserve_domain_id
 from ros_bridge.errors import BridgeError
 from ros_bridge.robot_link import RobotLink
 from ros_bridge.runtime import RosRuntime
-from sila_labware.deployment.processes import ProcessGroup, ros_environment
+from sila_labware.deployment.processes import ProcessGroup, interrupts_held, ros_environment
 from sila_labware.deployment.supervisor import RobotSideSupervisor
 from sila_labware.device.robot_controller import RobotController
 from sila_labware.device.station_controller import StationController
@@ -37,6 +41,8 @@ from sila_labware.servers.tls import CertificateAuthority
 logger = logging.getLogger(__name__)
 
 ROBOT_SIDE_MODULES = (("sim_node", "tiago_sim.sim_node"), ("sequencer", "tiago_sim.sequencer"))
+CHILD_STOP_S = 2.0
+"""How long a robot-side child has after SIGTERM before `Deployment.stop` kills it."""
 
 
 @dataclass
@@ -106,6 +112,8 @@ class Deployment:
         self.servers: list[ServedServer] = []
         self.ca_file: Path | None = None
         self.supervisor: RobotSideSupervisor | None = None
+        self._lifecycle_lock = threading.Lock()  # restarts (supervisor) vs. stop (caller)
+        self._stopping = False
 
     def start(self, should_stop: Callable[[], bool] = lambda: False) -> None:
         """Bring everything up; on any failure, stop what was started and re-raise."""
@@ -116,18 +124,41 @@ class Deployment:
             if self.options.restart_robot_side:
                 assert self.link is not None and self.robot is not None
                 self.supervisor = RobotSideSupervisor(
-                    self.children, self._start_robot_side, self.link, self.robot
+                    self.children,
+                    self._start_robot_side,
+                    self.link,
+                    self.robot,
+                    restart_bridge=self._restart_bridge,
                 ).start()
         except BaseException:
             self.stop()
             raise
 
     def _start_robot_side(self) -> None:
-        start_robot_side(self.children, self.options.world, self.options.extra_sim_arguments)
+        with self._lifecycle_lock:
+            self._refuse_if_stopping()
+            start_robot_side(self.children, self.options.world, self.options.extra_sim_arguments)
+
+    def _new_runtime(self) -> RosRuntime:
+        return RosRuntime("sila_labware_bridge", domain_id=self.domain_id).start()
+
+    def _restart_bridge(self) -> None:
+        """For the supervisor, after the ROS thread died: a new runtime under the same link."""
+        with self._lifecycle_lock:
+            self._refuse_if_stopping()
+            assert self.link is not None
+            if self.runtime is not None:
+                self.runtime.stop(timeout_s=1.0)  # ended already: returns at once
+            self.runtime = self._new_runtime()
+            self.link.attach(self.runtime)
+
+    def _refuse_if_stopping(self) -> None:
+        if self._stopping:
+            raise BridgeError("the deployment is stopping: nothing more is started")
 
     def _start_bridge(self, should_stop: Callable[[], bool]) -> None:
         join_ros_domain(self.domain_id)
-        self.runtime = RosRuntime("sila_labware_bridge", domain_id=self.domain_id).start()
+        self.runtime = self._new_runtime()
         self.link = RobotLink(self.runtime)
         deadline = time.monotonic() + self.options.ready_timeout_s
         while True:
@@ -155,21 +186,26 @@ class Deployment:
         authority = None if self.options.insecure else CertificateAuthority()
         for offset, (server, role, station_name) in enumerate(planned):
             port = self.options.port_base + offset
-            start_sila_server(
-                server, self.options.host, port, authority=authority, discovery=self.options.discovery
-            )
-            self.servers.append(
-                ServedServer(server.server_name, role, station_name, self.options.host, port, server)
-            )
+            with interrupts_held():  # a server started must be registered, so that stop() ends it
+                start_sila_server(
+                    server, self.options.host, port, authority=authority, discovery=self.options.discovery
+                )
+                self.servers.append(
+                    ServedServer(server.server_name, role, station_name, self.options.host, port, server)
+                )
         if authority is not None:
             self.ca_file = authority.write_certificate(self.options.ca_file)
 
     def check_healthy(self) -> None:
-        """Raise if the robot side is down for good (the supervisor gave up, or there is none)."""
-        if self.supervisor is None:
-            self.children.check_running()
-        elif self.supervisor.failure:
-            raise RuntimeError(self.supervisor.failure)
+        """Raise if the robot side or the bridge is down for good (the supervisor gave up, or
+        there is none and a child or the ROS thread ended)."""
+        if self.supervisor is not None:
+            if self.supervisor.failure:
+                raise RuntimeError(self.supervisor.failure)
+            return
+        self.children.check_running()
+        if self.runtime is not None and self.runtime.failure:
+            raise RuntimeError(f"the bridge's ROS thread ended ({self.runtime.failure})")
 
     def robot_server(self) -> ServedServer:
         return next(served for served in self.servers if served.role == "robot")
@@ -178,23 +214,34 @@ class Deployment:
         return next(served for served in self.servers if served.station == station)
 
     def stop(self) -> None:
-        """Stop servers (in parallel), the bridge, then the children; about 3 s at worst."""
-        if self.supervisor is not None:
-            self.supervisor.stop()
-            self.supervisor = None
-        stoppers = [
-            threading.Thread(target=_stop_server, args=(served.server,), daemon=True)
-            for served in self.servers
-        ]
-        for stopper in stoppers:
-            stopper.start()
-        for stopper in stoppers:
-            stopper.join(2.0)
-        self.servers.clear()
-        if self.runtime is not None:
-            self.runtime.stop(timeout_s=1.0)
-            self.runtime = None
-        self.children.stop(timeout_s=2.0)
+        """Refuse further restarts, then stop the bridge, the servers (in parallel) and the
+        children. Safe to call twice. The bridge goes first: its open goals end at once with
+        GoalAbandoned, so a command still running ends with its defined error and the server need
+        not wait for it. Typically under 1 s; at worst about 5 s (1 s for a restart under way to
+        notice, 1 s for the ROS thread, 2 s for the servers; the children got SIGTERM before all
+        that and get SIGKILL CHILD_STOP_S after it). Ctrl-C is held meanwhile
+        (`interrupts_held`): a stop is never cut short, so that no child is left running."""
+        with interrupts_held():
+            with self._lifecycle_lock:
+                self._stopping = True
+            if self.supervisor is not None:
+                self.supervisor.stop(timeout_s=1.0)
+                self.supervisor = None
+            self.children.terminate()  # they stop while the rest does
+            terminated_at = time.monotonic()
+            if self.runtime is not None:
+                self.runtime.stop(timeout_s=1.0)
+                self.runtime = None
+            stoppers = [
+                threading.Thread(target=_stop_server, args=(served.server,), daemon=True)
+                for served in self.servers
+            ]
+            for stopper in stoppers:
+                stopper.start()
+            for stopper in stoppers:
+                stopper.join(2.0)
+            self.servers.clear()
+            self.children.stop(timeout_s=max(0.0, terminated_at + CHILD_STOP_S - time.monotonic()))
 
 
 def _stop_server(server: SilaServer) -> None:

@@ -1,14 +1,19 @@
-"""Keep the robot side of a deployment alive: notice a dead child at once, fail the running
-command with a defined error, restart the robot side, and re-synchronise the inventory.
+"""Keep the robot side of a deployment alive: notice a dead child or a dead ROS thread at once,
+fail the running command with a defined error, restart, and re-synchronise the inventory.
 
 Why a supervisor and not only ROS timeouts: a killed node leaves the bridge's goal waiting for a
 result that never comes (DDS notices a dead participant only after its lease, ~20 s). The
-process that started the child knows within one poll period that it is gone.
+process that started the child knows within one poll period that it is gone. Likewise the
+bridge's own ROS thread: once it has ended (an rclpy callback raised), no answer reaches any goal
+and every SiLA command would fail with "the ROS runtime is not running" for good.
 
 Policy (documented in README, "Reliability"):
 - any robot-side child ending (sim node or sequencer) restarts the whole robot side: the two
   nodes share goals, and a fresh simulation starts from the world file, so the survivor's state
   would be stale;
+- the bridge's ROS thread ending is handled the same way, plus a new ROS runtime under the same
+  `RobotLink` (`restart_bridge`): the robot side is restarted too, because the goal it was running
+  for the lost runtime can no longer be watched or cancelled;
 - while it is down the robot reports state "error" with the reason, the running command ends
   with the feature's defined error (LabwareNotPicked/LabwareNotPlaced, or the motion's error),
   and every plate the inventory knows is marked unknown;
@@ -17,7 +22,7 @@ Policy (documented in README, "Reliability"):
 - after `max_restarts` restarts within `restart_window_s` the supervisor gives up and
   `failure` names why (the CLI then exits non-zero).
 
-Threads: one daemon thread polls the children; restarts run on it.
+Threads: one daemon thread polls the children and the ROS thread; restarts run on it.
 """
 
 from __future__ import annotations
@@ -37,9 +42,14 @@ from sila_labware.device.robot_controller import RobotController
 logger = logging.getLogger(__name__)
 
 
+ROS_THREAD = "ros_thread"
+"""The name a restart record gives the bridge's ROS thread (the children go by theirs)."""
+
+
 @dataclass
 class RestartRecord:
-    """One restart: which child ended, with which exit code, and how long recovery took."""
+    """One restart: which child ended (or ROS_THREAD), with which exit code (None for the ROS
+    thread), and how long recovery took."""
 
     child: str
     exit_code: int | None
@@ -55,9 +65,19 @@ class SupervisorSettings:
     restart_window_s: float = 600.0
 
 
+@dataclass(frozen=True)
+class _Loss:
+    """What the supervisor found gone: a child (name, exit code) or the ROS thread (why)."""
+
+    name: str
+    exit_code: int | None
+    what: str  # "sim_node ended (exit code -9)"
+
+
 @dataclass
 class RobotSideSupervisor:
-    """Watches `children`; `start_robot_side` starts them again (both nodes)."""
+    """Watches `children` and the link's ROS thread; `start_robot_side` starts the children again
+    (both nodes), `restart_bridge` (if given) puts the link on a new ROS runtime."""
 
     children: ProcessGroup
     start_robot_side: Callable[[], None]
@@ -66,6 +86,7 @@ class RobotSideSupervisor:
     settings: SupervisorSettings = field(default_factory=SupervisorSettings)
     restarts: list[RestartRecord] = field(default_factory=list)
     failure: str = ""
+    restart_bridge: Callable[[], None] | None = None
 
     def __post_init__(self) -> None:
         self._stop = threading.Event()
@@ -75,7 +96,10 @@ class RobotSideSupervisor:
         self._thread.start()
         return self
 
-    def stop(self, timeout_s: float = 5.0) -> None:
+    def stop(self, timeout_s: float = 1.0) -> None:
+        """Stop watching; wait up to `timeout_s` for a restart under way to notice. The owner must
+        refuse further restarts itself (`Deployment.stop` does): a daemon thread still inside one
+        after the wait finds its starts refused and ends."""
         self._stop.set()
         if self._thread.is_alive():
             self._thread.join(timeout_s)
@@ -86,28 +110,47 @@ class RobotSideSupervisor:
 
     def _watch(self) -> None:
         while not self._stop.wait(self.settings.poll_period_s):
-            dead = next((child for child in self.children.children if not child.running), None)
-            if dead is None:
+            loss = self._find_loss()
+            if loss is None or self._stop.is_set():  # a stop ends the children: no loss then
                 continue
-            if not self._may_restart():
-                self.failure = (
-                    f"{dead.name} ended (code {dead.popen.returncode}) and the robot side was already "
-                    f"restarted {self.settings.max_restarts} times "
-                    f"within {self.settings.restart_window_s:.0f} s"
-                )
-                logger.error("%s: giving up", self.failure)
-                self.link.mark_robot_side_lost(self.failure)
+            if loss.name == ROS_THREAD and self.restart_bridge is None:
+                self._give_up(f"{loss.what}, and this deployment cannot restart the bridge")
                 return
-            self._recover(dead.name, dead.popen.returncode)
+            if not self._may_restart():
+                self._give_up(
+                    f"{loss.what} and the robot side was already restarted {self.settings.max_restarts} "
+                    f"times within {self.settings.restart_window_s:.0f} s"
+                )
+                return
+            self._recover(loss)
+
+    def _find_loss(self) -> _Loss | None:
+        failure = self.link.runtime.failure
+        if failure:
+            return _Loss(ROS_THREAD, None, f"the bridge's ROS thread ended ({failure})")
+        for child in self.children.children:
+            if not child.running:
+                code = child.popen.returncode
+                return _Loss(child.name, code, f"{child.name} ended (exit code {code})")
+        return None
+
+    def _give_up(self, failure: str) -> None:
+        self.failure = failure
+        logger.error("%s: giving up", failure)
+        self.link.mark_robot_side_lost(failure)
+        self.robot.abort_active_goal(failure)
 
     def _may_restart(self) -> bool:
         window_start = time.monotonic() - self.settings.restart_window_s
         return sum(record.started_at >= window_start for record in self.restarts) < self.settings.max_restarts
 
-    def _recover(self, child_name: str, exit_code: int | None) -> None:
-        record = RestartRecord(child_name, exit_code, time.monotonic())
+    def _recover(self, loss: _Loss) -> None:
+        """Restart what `loss` calls for; `failure` says why if that failed."""
+        record = RestartRecord(loss.name, loss.exit_code, time.monotonic())
         self.restarts.append(record)
-        reason = f"robot side lost: {child_name} ended (exit code {exit_code}); restarting it"
+        bridge_lost = loss.name == ROS_THREAD
+        restarting = "the bridge and the robot side" if bridge_lost else "it"
+        reason = f"robot side lost: {loss.what}; restarting {restarting}"
         logger.error("%s", reason)
         self.link.mark_robot_side_lost(reason)
         self.robot.abort_active_goal(reason)
@@ -117,8 +160,11 @@ class RobotSideSupervisor:
         # The surviving node published until it was stopped; let its last samples arrive, then
         # mark the side lost again so only the new robot side's state counts as "back".
         time.sleep(0.5)
-        self.link.mark_robot_side_lost(reason)
         try:
+            if bridge_lost:
+                assert self.restart_bridge is not None  # checked in _watch
+                self.restart_bridge()
+            self.link.mark_robot_side_lost(reason)
             self.start_robot_side()
             self._wait_until_ready()
         except Exception as error:  # noqa: BLE001 - ChildExited, BridgeError, OSError: give up, say why
@@ -134,6 +180,8 @@ class RobotSideSupervisor:
         deadline = time.monotonic() + self.settings.ready_timeout_s
         while not self._stop.is_set():
             self.children.check_running()
+            if self.link.runtime.failure:
+                raise BridgeError(f"the new ROS thread ended as well ({self.link.runtime.failure})")
             try:
                 self.link.wait_until_ready(timeout_s=1.0)
                 # A state message of the new robot side, not the one we injected.

@@ -4,7 +4,9 @@
 `python -m sila_labware.servers.station_server --station NAME`
 use this: they start no child processes, only the ROS bridge (in the ROS domain of the
 environment) and one server, and stop on SIGINT/SIGTERM. This is the path for a real TIAGo++
-whose own ROS 2 action servers implement labware_interfaces.
+whose own ROS 2 action servers implement labware_interfaces. Nothing supervises the bridge here:
+if its ROS thread ends, the server exits 1 naming why (whatever started it should start it again)
+rather than refuse every command for ever.
 """
 
 from __future__ import annotations
@@ -69,7 +71,9 @@ def run_standalone(
             authority.write_certificate(args.ca_file)
         sys.stdout.write(f"{server.server_name} at {args.host}:{args.port}\n")
         sys.stdout.flush()
-        stop.wait()
+        while not stop.wait(0.5):  # until Ctrl-C or SIGTERM, or the bridge can no longer work
+            if runtime.failure:
+                raise RuntimeError(f"the bridge's ROS thread ended ({runtime.failure})")
         return 0
     except Exception as error:  # noqa: BLE001 - one line for the user
         sys.stderr.write(f"{parser.prog}: {error}\n")

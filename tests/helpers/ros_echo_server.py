@@ -4,6 +4,11 @@ Serves /navigate_to_poi (NavigateToPoi): drives a pretend base for `--goal-secon
 feedback at 20 Hz; POI "nowhere" aborts with UNKNOWN_POI; cancel is honoured. Serves
 /describe_workcell with two stations. Publishes RobotState on /robot_state at 10 Hz, whose
 `detail` counts the goals finished so far. Prints "READY" once everything is created.
+
+A misbehaving robot side, for the bridge's own tests: `--accept-delay-s S` answers every goal
+request only after S seconds (a slow or overloaded action server), and `--goal-log FILE` appends
+one line per goal event ("accepted POI", "canceled POI", "succeeded POI", "aborted POI"), so a
+test can see what the robot side really did.
 """
 
 from __future__ import annotations
@@ -12,6 +17,7 @@ import argparse
 import sys
 import threading
 import time
+from pathlib import Path
 
 import rclpy
 from labware_interfaces.action import NavigateToPoi
@@ -27,9 +33,13 @@ from ros_bridge.latency_peer import serve_node
 class EchoRobot(Node):
     """Pretend robot: one action, one service, one state topic."""
 
-    def __init__(self, goal_seconds: float) -> None:
+    def __init__(
+        self, goal_seconds: float, accept_delay_s: float = 0.0, goal_log: Path | None = None
+    ) -> None:
         super().__init__("bridge_test_echo_robot")
         self._goal_seconds = goal_seconds
+        self._accept_delay_s = accept_delay_s
+        self._goal_log = goal_log
         self._finished_goals = 0
         self._current_poi = ""
         self._lock = threading.Lock()
@@ -39,7 +49,7 @@ class EchoRobot(Node):
             NavigateToPoi,
             "/navigate_to_poi",
             execute_callback=self._execute,
-            goal_callback=lambda _goal: GoalResponse.ACCEPT,
+            goal_callback=self._accept,
             cancel_callback=lambda _handle: CancelResponse.ACCEPT,
             callback_group=group,
         )
@@ -48,6 +58,16 @@ class EchoRobot(Node):
         )
         self._state_publisher = self.create_publisher(RobotState, "/robot_state", 1)
         self._timer = self.create_timer(0.1, self._publish_state, callback_group=group)
+
+    def _accept(self, goal: NavigateToPoi.Goal) -> GoalResponse:
+        time.sleep(self._accept_delay_s)
+        self._log("accepted", goal.poi)
+        return GoalResponse.ACCEPT
+
+    def _log(self, event: str, poi: str) -> None:
+        if self._goal_log is not None:
+            with self._lock, self._goal_log.open("a") as log:
+                log.write(f"{event} {poi}\n")
 
     def _describe(self, _request: DescribeWorkcell.Request, response: DescribeWorkcell.Response):
         response.stations = [
@@ -73,6 +93,7 @@ class EchoRobot(Node):
         poi = goal_handle.request.poi
         result = NavigateToPoi.Result()
         if poi == "nowhere":
+            self._log("aborted", poi)
             goal_handle.abort()
             result.success, result.error_code = False, ErrorCodes.UNKNOWN_POI
             result.message = f"no point of interest named {poi!r}"
@@ -81,6 +102,7 @@ class EchoRobot(Node):
         while True:
             elapsed = time.monotonic() - started
             if goal_handle.is_cancel_requested:
+                self._log("canceled", poi)
                 goal_handle.canceled()
                 result.success, result.error_code = False, ErrorCodes.CANCELED
                 result.message = f"cancelled after {elapsed:.2f} s"
@@ -94,6 +116,7 @@ class EchoRobot(Node):
             )
             goal_handle.publish_feedback(feedback)
             time.sleep(0.05)
+        self._log("succeeded", poi)
         goal_handle.succeed()
         with self._lock:
             self._finished_goals += 1
@@ -105,9 +128,11 @@ class EchoRobot(Node):
 def main() -> int:
     parser = argparse.ArgumentParser()
     parser.add_argument("--goal-seconds", type=float, default=1.0)
+    parser.add_argument("--accept-delay-s", type=float, default=0.0)
+    parser.add_argument("--goal-log", type=Path, default=None)
     args = parser.parse_args()
     rclpy.init()
-    return serve_node(EchoRobot(args.goal_seconds))
+    return serve_node(EchoRobot(args.goal_seconds, args.accept_delay_s, args.goal_log))
 
 
 if __name__ == "__main__":

@@ -57,7 +57,7 @@ def test_an_unsuccessful_outcome_is_an_answer_not_an_exception() -> None:
     goal.set_finished(BLOCKED)
     assert goal.done and not goal.success
     goal.wait(SHORT_S)  # does not raise: the robot side answered
-    assert goal.result().error_code == "PATH_BLOCKED"
+    assert goal.result(SHORT_S).error_code == "PATH_BLOCKED"
     assert goal.exception() is None
     assert goal.progress.progress == 0.4, "a failed goal keeps the progress it reached"
 
@@ -193,6 +193,37 @@ def test_abort_ends_a_waiting_goal_with_goal_abandoned_and_a_late_answer_is_igno
     assert str(waiter_saw[0]) == "/get_labware: robot side lost: sim ended (exit code -9)"
     assert not goal.set_finished(ARRIVED), "the robot side's late answer changes nothing"
     assert isinstance(goal.exception(), GoalAbandoned) and not goal.success
+
+
+def test_an_acceptance_that_does_not_come_in_time_withdraws_the_goal() -> None:
+    """wait_accepted gives up: the creator is asked to cancel (it will, once accepted), the goal ends
+    with BridgeTimeout, and the late acceptance, feedback and result change nothing."""
+    cancel_requests: list[float] = []
+    goal = ActionGoal(
+        "/get_labware", cancel_request=lambda timeout_s: cancel_requests.append(timeout_s) or True
+    )
+    with pytest.raises(
+        BridgeTimeout, match="/get_labware: no answer to the goal request within 0.0 s.*withdrawn"
+    ):
+        goal.wait_accepted(SHORT_S)
+    assert cancel_requests == [5.0]
+    assert goal.done and goal.accepted is None and isinstance(goal.exception(), BridgeTimeout)
+    assert not goal.set_accepted() and not goal.update_progress(0.5, "grasping", 1.0)
+    assert not goal.set_finished(ARRIVED) and not goal.success
+
+
+def test_a_withdrawn_goal_that_ended_meanwhile_keeps_its_end() -> None:
+    goal = ActionGoal("/dock")
+    goal.set_rejected()
+    assert not goal.withdraw("no answer in time")
+    assert goal.outcome is not None and goal.outcome.status == "REJECTED"
+
+
+def test_every_wait_on_a_goal_needs_a_bound() -> None:
+    goal = ActionGoal("/undock")
+    for wait in (goal.wait_accepted, goal.wait, goal.result, goal.exception):
+        with pytest.raises(TypeError, match="needs a timeout"):
+            wait(None)  # type: ignore[arg-type]
 
 
 def test_progress_never_goes_down_and_listeners_see_what_is_shown() -> None:

@@ -1,4 +1,5 @@
-"""The `sila-labware` command: usage errors, `serve` under signals, `demo --json`."""
+"""The `sila-labware` command: usage errors, `serve` and `demo` under signals, `demo --json`, and
+what a run leaves in the temp folder (nothing)."""
 
 from __future__ import annotations
 
@@ -6,8 +7,10 @@ import json
 import os
 import re
 import signal
+import socket
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -21,8 +24,31 @@ from tests.helpers.sila_stack import free_port_base
 CLI = [sys.executable, "-m", "sila_labware.cli"]
 
 
-def run_cli(*arguments: str, timeout_s: float = 30.0) -> subprocess.CompletedProcess:
-    return subprocess.run([*CLI, *arguments], capture_output=True, text=True, timeout=timeout_s)
+def run_cli(
+    *arguments: str, timeout_s: float = 30.0, temp_dir: Path | None = None
+) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [*CLI, *arguments], capture_output=True, text=True, timeout=timeout_s, env=_environment(temp_dir)
+    )
+
+
+def _environment(temp_dir: Path | None) -> dict[str, str]:
+    """This run's environment, with its temp folder in `temp_dir` (to see what the CLI leaves)."""
+    environment = dict(os.environ)
+    if temp_dir is not None:
+        temp_dir.mkdir(parents=True, exist_ok=True)
+        environment["TMPDIR"] = str(temp_dir)
+    return environment
+
+
+def left_in_temp(temp_dir: Path) -> list[str]:
+    """What a run left in its temp folder of its own making (the `sila-labware-*` entries, but the
+    ROS domain locks, which are shared by design)."""
+    return sorted(
+        entry.name
+        for entry in temp_dir.iterdir()
+        if entry.name.startswith("sila-labware-") and entry.name != "sila-labware-ros-domains"
+    )
 
 
 def test_help_lists_subcommands() -> None:
@@ -116,6 +142,7 @@ def test_demo_json_reports_the_transfer_and_records_pictures(tmp_path: Path) -> 
         "--log-dir",
         str(tmp_path / "logs"),
         timeout_s=600,
+        temp_dir=tmp_path / "tmp",
     )
     report = json.loads(done.stdout)
     assert set(report) >= {
@@ -132,6 +159,79 @@ def test_demo_json_reports_the_transfer_and_records_pictures(tmp_path: Path) -> 
     assert done.returncode == 0, done.stderr[-2000:]
     assert "without encryption" in done.stderr.lower()
     assert_run_pictures(record_dir)
+    assert left_in_temp(tmp_path / "tmp") == [], "a successful demo leaves nothing in the temp folder"
+
+
+def test_demo_json_reports_a_start_up_failure_as_an_object_and_cleans_up(tmp_path: Path) -> None:
+    """The robot's port is taken: nothing to transfer, but `--json` still prints one object saying
+    so, and the run's CA directory goes."""
+    port_base = free_port_base(4)
+    with socket.socket() as squatter:
+        squatter.bind(("127.0.0.1", port_base))
+        squatter.listen()
+        done = run_cli(
+            "demo",
+            "--json",
+            "--no-discovery",
+            "--port-base",
+            str(port_base),
+            timeout_s=180,
+            temp_dir=tmp_path / "tmp",
+        )
+    assert done.returncode == 1, done.stderr[-2000:]
+    report = json.loads(done.stdout)
+    assert report["success"] is False
+    assert (
+        report["error"].startswith("could not start: ")
+        and f"127.0.0.1:{port_base} is already in use" in (report["error"])
+    )
+    assert f"sila-labware: could not start: 127.0.0.1:{port_base} is already in use" in done.stderr
+    assert left_in_temp(tmp_path / "tmp") == [], "a failed demo leaves nothing in the temp folder"
+
+
+def test_ctrl_c_stops_a_demo_mid_transfer_within_5_s_and_leaves_nothing_behind(tmp_path: Path) -> None:
+    """SIGINT once the first step of the transfer is done: the demo ends within 5 s with exit code
+    130, says so in its JSON object, and neither its robot side (own sessions, which a terminal's
+    Ctrl-C never reaches) nor its temp directory survives it."""
+    temp_dir = tmp_path / "tmp"
+    demo = subprocess.Popen(
+        [*CLI, "demo", "--json", "--no-discovery", "--port-base", str(free_port_base(4))],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=_environment(temp_dir),
+    )
+    stderr_lines: list[str] = []
+    try:
+        assert demo.stderr is not None
+        for line in demo.stderr:
+            stderr_lines.append(line)
+            if " done in " in line:  # the first step finished: the transfer is under way
+                break
+        else:
+            pytest.fail(f"the demo ended before its first step: {''.join(stderr_lines)[-2000:]}")
+        child_pids = [int(pid) for pid in re.findall(r"robot side: \w+ pid (\d+)", "".join(stderr_lines))]
+        assert len(child_pids) == 2 and all(_pid_alive(pid) for pid in child_pids)
+        rest: list[str] = []
+        reader = threading.Thread(target=lambda: rest.extend(demo.stderr), daemon=True)
+        reader.start()
+        started = time.monotonic()
+        demo.send_signal(signal.SIGINT)
+        returncode = demo.wait(timeout=30)
+        stopped_after_s = time.monotonic() - started
+        reader.join(5.0)
+        stdout = demo.stdout.read() if demo.stdout else ""
+    finally:
+        if demo.poll() is None:
+            demo.kill()
+            demo.wait()
+    assert stopped_after_s < 5.0, f"stopped after {stopped_after_s:.1f} s"
+    assert returncode == 130, "".join(rest)[-2000:]
+    assert not [pid for pid in child_pids if _pid_alive(pid)], "the robot side outlived the demo"
+    report = json.loads(stdout)
+    assert report["success"] is False and report["error"].startswith("interrupted")
+    assert "Traceback" not in "".join(rest), "".join(rest)[-3000:]
+    assert left_in_temp(temp_dir) == [], "an interrupted demo leaves nothing in the temp folder"
 
 
 def assert_run_pictures(record_dir: Path) -> None:

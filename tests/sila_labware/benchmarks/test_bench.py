@@ -170,12 +170,15 @@ def test_sigterm_stops_the_campaign_its_robot_side_and_summarises_what_was_done(
     the bench once left sim_node and sequencer running. Now the running trial is abandoned, its
     processes stop, and the trials done so far are summarised with exit code 130."""
     domain_id = os.environ["ROS_DOMAIN_ID"]
-    stack = ["--insecure", "--no-discovery", "--port-base", str(free_port_base(4))]
+    stack = ["--no-discovery", "--port-base", str(free_port_base(4))]  # TLS: the run writes a CA file
+    temp_dir = tmp_path / "tmp"
+    temp_dir.mkdir()
     bench = subprocess.Popen(
         [*CLI, "bench", *stack, "--trials", "3", "--seed", str(SEED), "--json"],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        env={**os.environ, "TMPDIR": str(temp_dir)},
     )
     try:
         assert bench.stderr is not None
@@ -201,3 +204,4 @@ def test_sigterm_stops_the_campaign_its_robot_side_and_summarises_what_was_done(
     summary = json.loads(stdout)
     assert summary["trials"] == 1 and summary["interrupted_after_trials"] == 1
     assert "interrupted: trial seed" in stderr
+    assert not list(temp_dir.glob("sila-labware-bench-*")), "the run's CA directory outlived it"
