@@ -18,11 +18,6 @@ from sila2.server import ObservableCommandInstance
 from ros_bridge.progress import ProgressReport
 from sila_labware.device.errors import ParameterError
 
-COMMAND_LIFETIME = timedelta(minutes=10)
-"""How long a finished observable command's result stays available to clients, counted from its
-start. sila2 keeps one waiting thread per command for this long, so it bounds the threads of a
-busy server (a transfer runs 8 commands: at one transfer per 12 s, about 400 threads)."""
-
 logger = logging.getLogger(__name__)
 
 

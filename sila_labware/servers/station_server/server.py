@@ -10,6 +10,7 @@ from uuid import UUID, uuid4
 from sila2.server import SilaServer
 
 from sila_labware.device.station_controller import StationController
+from sila_labware.servers.finished_commands import FinishedCommandReaper
 from sila_labware.servers.grpc_interceptors import serve_with_interceptors
 from sila_labware.servers.initiation_checks import InitiationChecks, check_labware_transfer
 from sila_labware.servers.locking import serve_lock_controller
@@ -59,3 +60,9 @@ class Server(SilaServer):
         initiation_checks = InitiationChecks()
         check_labware_transfer(initiation_checks, LabwareTransferSiteControllerFeature, station.parameters)
         serve_with_interceptors(self, [lock_guard, initiation_checks])
+        # results of finished observable commands, kept for their lifetime by one thread
+        self.finished_commands = FinishedCommandReaper(self).start()
+
+    def stop(self, grace_period: float | None = None) -> None:
+        self.finished_commands.stop()
+        super().stop(grace_period)

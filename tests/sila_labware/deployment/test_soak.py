@@ -40,23 +40,19 @@ BRIDGE_NODE = "sila_labware_bridge"
 # Bounds, measured from the baseline taken after the first round trip (A->B->A), when every pool,
 # cache and lazily created gRPC/DDS thread has been used once (the sample after the first transfer
 # is reported too, but the way back still warms up the other station's paths):
-# - threads: sila2 keeps one thread per observable command execution for the command's lifetime of
-#   execution (sila_glue.COMMAND_LIFETIME, 10 min from its start) so that clients can still fetch its
-#   result; a transfer runs 8 observable commands (4 on the robot, 2 on each station), all in the
-#   serve process. So the serve process may gain at most 8 threads per transfer (they end 10 min
-#   after their command started), plus 4 for noise; the robot-side children must stay within 4
-#   threads. A thread leaked per goal, subscription or gRPC stream would exceed this by 48.
-#   Noise is a pool thread first needed after the baseline: two soaks ended at the same 443
-#   threads from baselines of 57 and 56 (8 per transfer in between, exactly).
-# - memory: 25 MiB per process, plus 64 KiB for each of those parked threads in the serve process
-#   (about 35 KiB each was measured: touched stack pages and interpreter state). Allocator noise
+# - threads: no process may gain more than 4 threads (noise: a pool thread first needed after the
+#   baseline). Finished observable commands keep their results for their lifetime (10 min), but in
+#   one thread per server (servers/finished_commands.py); before, sila2 parked one thread per
+#   command for that time, 8 per transfer (1,098 threads after 131 transfers). A thread leaked per
+#   goal, subscription, gRPC stream or command would exceed the bound by 48.
+# - memory: 25 MiB per process, plus 64 KiB per thread gained (about 35 KiB each was measured:
+#   touched stack pages and interpreter state). Allocator noise
 #   between samples was a few MiB; a leak of what a transfer handles (one 640x480 RGBA frame =
 #   1.2 MiB, per-goal feedback messages, a gRPC call state) repeated 48 times would exceed it, so a
 #   per-transfer leak of about 0.5 MiB fails here.
-OBSERVABLE_COMMANDS_PER_TRANSFER = 8
 THREAD_NOISE = 4
 MEMORY_GROWTH_LIMIT_KIB = 25 * 1024
-MEMORY_PER_PARKED_THREAD_KIB = 64
+MEMORY_PER_THREAD_KIB = 64
 TERMINAL_GOAL_STATES = {GoalStatus.STATUS_SUCCEEDED, GoalStatus.STATUS_CANCELED, GoalStatus.STATUS_ABORTED}
 
 
@@ -218,10 +214,9 @@ def test_many_transfers_in_one_serve_process_leak_nothing(tmp_path: Path) -> Non
         )
         for name in watched:
             thread_growth = end[name].threads - baseline[name].threads
-            parked_threads = OBSERVABLE_COMMANDS_PER_TRANSFER * (last - 2) if name == "serve" else 0
-            assert thread_growth <= parked_threads + THREAD_NOISE, (name, baseline[name], end[name])
+            assert thread_growth <= THREAD_NOISE, (name, baseline[name], end[name])
             memory_growth = end[name].rss_kib - baseline[name].rss_kib
-            memory_limit = MEMORY_GROWTH_LIMIT_KIB + MEMORY_PER_PARKED_THREAD_KIB * max(0, thread_growth)
+            memory_limit = MEMORY_GROWTH_LIMIT_KIB + MEMORY_PER_THREAD_KIB * max(0, thread_growth)
             assert memory_growth <= memory_limit, f"{name} grew {memory_growth} KiB over the soak"
         assert graph[last] == graph[2], "the bridge's ROS endpoints changed: subscriptions leak"
         assert goals_left and not any(goals_left.values()), f"goals still open: {goals_left}"

@@ -17,7 +17,6 @@ from sila2.server import MetadataDict, ObservableCommandInstance
 from sila_labware.device.errors import CommandSequenceError, MotionFailed, ParameterError, TransferFailed
 from sila_labware.device.robot_controller import INTERMEDIATE_ACTIONS
 from sila_labware.servers.sila_glue import (
-    COMMAND_LIFETIME,
     handover_position,
     progress_reporter,
     validation_error,
@@ -50,10 +49,6 @@ class LabwareTransferManipulatorControllerImpl(LabwareTransferManipulatorControl
         super().__init__(parent_server=parent_server)
         self.robot = parent_server.robot
         self.commands = parent_server.cancellable_commands
-        self.PrepareForInput_default_lifetime_of_execution = COMMAND_LIFETIME
-        self.PrepareForOutput_default_lifetime_of_execution = COMMAND_LIFETIME
-        self.PutLabware_default_lifetime_of_execution = COMMAND_LIFETIME
-        self.GetLabware_default_lifetime_of_execution = COMMAND_LIFETIME
 
     def get_AvailableHandoverPositions(self, *, metadata: MetadataDict) -> list[HandoverPosition]:
         return [handover_position(name, count) for name, count in self.robot.handover_positions()]

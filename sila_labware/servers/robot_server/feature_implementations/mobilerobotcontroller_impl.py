@@ -16,7 +16,7 @@ from sila2.server import MetadataDict, ObservableCommandInstance
 
 from ros_bridge.workcell import RobotStatus
 from sila_labware.device.errors import CommandSequenceError, MotionFailed, ParameterError
-from sila_labware.servers.sila_glue import COMMAND_LIFETIME, progress_reporter, validation_error
+from sila_labware.servers.sila_glue import progress_reporter, validation_error
 
 from ..generated.mobilerobotcontroller import (
     Dock_Responses,
@@ -67,9 +67,6 @@ class MobileRobotControllerImpl(MobileRobotControllerBase):
         super().__init__(parent_server=parent_server)
         self.robot = parent_server.robot
         self.commands = parent_server.cancellable_commands
-        self.Dock_default_lifetime_of_execution = COMMAND_LIFETIME
-        self.Undock_default_lifetime_of_execution = COMMAND_LIFETIME
-        self.DriveToPointOfInterest_default_lifetime_of_execution = COMMAND_LIFETIME
         # Subscribers wait forever without a first value: publish the current state now.
         self._publish_status(self.robot.link.robot_status())
         self.robot.link.on_robot_status(self._publish_status)

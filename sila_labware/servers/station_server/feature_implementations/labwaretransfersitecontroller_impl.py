@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 from sila2.server import MetadataDict, ObservableCommandInstance
 
 from sila_labware.device.errors import CommandSequenceError, ParameterError
-from sila_labware.servers.sila_glue import COMMAND_LIFETIME, handover_position, validation_error
+from sila_labware.servers.sila_glue import handover_position, validation_error
 
 from ..generated.labwaretransfersitecontroller import (
     HandoverPosition,
@@ -37,10 +37,6 @@ class LabwareTransferSiteControllerImpl(LabwareTransferSiteControllerBase):
     def __init__(self, parent_server: Server) -> None:
         super().__init__(parent_server=parent_server)
         self.station = parent_server.station
-        self.PrepareForInput_default_lifetime_of_execution = COMMAND_LIFETIME
-        self.PrepareForOutput_default_lifetime_of_execution = COMMAND_LIFETIME
-        self.LabwareDelivered_default_lifetime_of_execution = COMMAND_LIFETIME
-        self.LabwareRemoved_default_lifetime_of_execution = COMMAND_LIFETIME
 
     def get_AvailableHandoverPositions(self, *, metadata: MetadataDict) -> list[HandoverPosition]:
         return [handover_position(name, count) for name, count in self.station.handover_positions()]

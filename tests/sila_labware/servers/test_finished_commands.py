@@ -1,0 +1,54 @@
+"""Finished observable commands keep their results, not a thread each.
+
+Before: sila2 waited out each finished command's lifetime (10 minutes) in a thread of its own, so
+a busy serve process grew by 8 threads per transfer (1,098 threads after 131 transfers). Real
+servers, a real sila2 client, the real robot side; the threads are this process's (the servers run
+in it).
+"""
+
+from __future__ import annotations
+
+import datetime
+import threading
+from collections.abc import Iterator
+
+import pytest
+from sila2.framework import InvalidCommandExecutionUUID
+
+from sila_labware.deployment.stack import Deployment
+from tests.helpers.sila_stack import client_for, start_stack
+from tests.helpers.transfer_steps import finish
+
+
+@pytest.fixture(scope="module")
+def stack(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Deployment]:
+    deployment = start_stack(tmp_path_factory.mktemp("finished_commands"), insecure=True)
+    yield deployment
+    deployment.stop()
+
+
+def test_many_finished_commands_leave_no_thread_behind(stack: Deployment) -> None:
+    mobile = client_for(stack, stack.robot_server()).MobileRobotController
+    finish(mobile.Dock())  # warm up: pools and subscriptions a first command starts
+    before = threading.active_count()
+    for _ in range(40):
+        finish(mobile.Dock())  # docked already: each ends at once, its result kept
+    assert threading.active_count() - before <= 4, "a thread per finished command is back"
+
+
+def test_a_result_is_kept_for_the_lifetime_then_forgotten(stack: Deployment) -> None:
+    served = stack.robot_server()
+    mobile = client_for(stack, served).MobileRobotController
+    instance = mobile.Dock()
+    finish(instance)
+    reaper = served.server.finished_commands
+    reaper.sweep()  # the lifetime (10 minutes) has not passed: the result stays
+    instance.get_responses()
+    lifetime = reaper.lifetime
+    try:
+        reaper.lifetime = datetime.timedelta(0)
+        assert reaper.sweep() >= 1
+    finally:
+        reaper.lifetime = lifetime
+    with pytest.raises(InvalidCommandExecutionUUID):
+        instance.get_responses()
