@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import datetime
 import threading
+import time
 from collections.abc import Iterator
 
 import pytest
@@ -52,3 +53,38 @@ def test_a_result_is_kept_for_the_lifetime_then_forgotten(stack: Deployment) -> 
         reaper.lifetime = lifetime
     with pytest.raises(InvalidCommandExecutionUUID):
         instance.get_responses()
+
+
+@pytest.mark.soak
+def test_threads_stay_flat_past_the_lifetime_while_results_expire(stack: Deployment) -> None:
+    """A run longer than the lifetime: 2 finished commands a second for the lifetime plus 90 s.
+    The kept results grow for the lifetime, then level off as the oldest are forgotten; the
+    thread count stays flat throughout. Run apart: `./run test -m soak -s <this file>`."""
+    served = stack.robot_server()
+    mobile = client_for(stack, served).MobileRobotController
+    reaper = served.server.finished_commands
+    duration_s = reaper.lifetime.total_seconds() + 90.0
+
+    def kept_results() -> int:
+        return sum(
+            len(managers)
+            for servicer in served.server.feature_servicers.values()
+            for managers in getattr(servicer, "observable_command_managers", {}).values()
+        )
+
+    finish(mobile.Dock())
+    started = time.monotonic()
+    samples: list[tuple[float, int, int]] = []
+    next_sample = started
+    while (elapsed := time.monotonic() - started) < duration_s:
+        finish(mobile.Dock())
+        if time.monotonic() >= next_sample:
+            samples.append((round(elapsed), threading.active_count(), kept_results()))
+            next_sample += 30.0
+        time.sleep(0.5)
+    samples.append((round(time.monotonic() - started), threading.active_count(), kept_results()))
+    print("elapsed s, threads, kept results:", samples)
+    threads = [count for _, count, _ in samples]
+    assert max(threads) - min(threads) <= 4, samples
+    at_lifetime = max(kept for elapsed, _, kept in samples if elapsed <= reaper.lifetime.total_seconds())
+    assert samples[-1][2] <= at_lifetime + 10, "results older than the lifetime are not forgotten"
