@@ -91,6 +91,12 @@ def build_parser() -> argparse.ArgumentParser:
         )
         sub.add_argument("--no-discovery", action="store_true", help="do not announce the servers (mDNS)")
         sub.add_argument(
+            "--name",
+            default="",
+            help="the lab's name, carried by every server name so that two labs on one network are told "
+            "apart (default: the world file's `name`, else its file name)",
+        )
+        sub.add_argument(
             "--domain-id", type=int, default=None, help="ROS domain (default: $ROS_DOMAIN_ID or random)"
         )
         sub.add_argument(
@@ -144,6 +150,13 @@ def _validate(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None
         parser.error(f"world file not found: {args.world}")
     if not 1 <= args.port_base <= 65535 - 16:
         parser.error(f"--port-base {args.port_base} is not a usable port")
+    if args.name:
+        from sila_labware.deployment.lab_name import check_lab_name
+
+        try:
+            check_lab_name(args.name)
+        except ValueError as error:
+            parser.error(f"--name: {error}")
     if args.domain_id is not None and not 0 <= args.domain_id <= 232:
         parser.error(f"--domain-id {args.domain_id} is outside 0..232")
     if args.command == "bench":
@@ -183,6 +196,7 @@ def _deployment_options(args: argparse.Namespace, ca_file: Path) -> DeploymentOp
         ready_timeout_s=args.ready_timeout,
         log_dir=args.log_dir,
         extra_sim_arguments=_record_arguments(args),
+        lab_name=args.name,
     )
 
 

@@ -29,6 +29,7 @@ from ros_bridge.domain import reserve_domain_id
 from ros_bridge.errors import BridgeError
 from ros_bridge.robot_link import RobotLink
 from ros_bridge.runtime import RosRuntime
+from sila_labware.deployment.lab_name import lab_name_of, robot_server_name, station_server_name
 from sila_labware.deployment.processes import ProcessGroup, interrupts_held, ros_environment
 from sila_labware.deployment.supervisor import RobotSideSupervisor
 from sila_labware.device.robot_controller import RobotController
@@ -59,6 +60,8 @@ class DeploymentOptions:
     extra_sim_arguments: list[str] = field(default_factory=list)
     restart_robot_side: bool = True
     """Restart the robot side when a child ends (see sila_labware.deployment.supervisor)."""
+    lab_name: str = ""
+    """Carried by every server name (see lab_name.py); empty: the world file's."""
 
 
 @dataclass(frozen=True)
@@ -180,9 +183,14 @@ class Deployment:
 
     def _start_servers(self) -> None:
         assert self.robot is not None and self.workcell is not None and self.link is not None
-        planned: list[tuple[SilaServer, str, str]] = [(RobotServer(self.robot), "robot", "")]
+        lab = self.options.lab_name or lab_name_of(self.options.world)
+        planned: list[tuple[SilaServer, str, str]] = [
+            (RobotServer(self.robot, name=robot_server_name(lab)), "robot", "")
+        ]
         for station in self.workcell.stations:
-            planned.append((StationServer(StationController(self.link, station)), "station", station.name))
+            controller = StationController(self.link, station)
+            server = StationServer(controller, name=station_server_name(lab, station.name))
+            planned.append((server, "station", station.name))
         authority = None if self.options.insecure else CertificateAuthority()
         for offset, (server, role, station_name) in enumerate(planned):
             port = self.options.port_base + offset

@@ -34,7 +34,12 @@ def _ephemeral_ports(count: int) -> Iterator[int]:
 
 
 def start_stack(
-    tmp_dir: Path, *, insecure: bool = False, discovery: bool = False, world: Path = DEFAULT_WORLD
+    tmp_dir: Path,
+    *,
+    insecure: bool = False,
+    discovery: bool = False,
+    world: Path = DEFAULT_WORLD,
+    lab_name: str = "",
 ) -> Deployment:
     deployment = Deployment(
         DeploymentOptions(
@@ -46,6 +51,7 @@ def start_stack(
             discovery=discovery,
             ready_timeout_s=120.0,
             log_dir=tmp_dir / "logs",
+            lab_name=lab_name,
         )
     )
     deployment.start()

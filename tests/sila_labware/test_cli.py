@@ -115,7 +115,7 @@ def test_serve_prints_servers_and_stops_everything_quickly(
         assert len(child_pids) == 2
 
         client = SilaClient("127.0.0.1", port_base, root_certs=ca_file.read_bytes())
-        assert client.SiLAService.ServerName.get() == "TIAGo Labware Robot"
+        assert client.SiLAService.ServerName.get() == "TIAGo Labware Robot (default lab)"
 
         started = time.monotonic()
         serve.send_signal(stop_signal)

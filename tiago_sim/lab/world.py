@@ -133,6 +133,8 @@ class World:
     hotel_slots: int = 2
     floor_size: float = 12.0
     extras: Mapping[str, Any] = field(default_factory=dict)
+    name: str = ""
+    """The lab's name (optional in the file): the SiLA servers carry it in their names."""
 
     def station(self, name: str) -> Station:
         for station in self.stations:
@@ -325,6 +327,7 @@ def load_world(path: str | Path = DEFAULT_WORLD) -> World:
         True,
         hotel_slots,
         r.number(data, "floor_size", "", 2.0, 100.0, default=12.0),
+        name=r.text(data, "name", "", default=Path(path).stem),
     )
 
 

@@ -98,7 +98,7 @@ def test_insecure_serve_warns_at_start(tmp_path: Path) -> None:
     try:
         # Plain text really works in this mode (what the warning is about) ...
         client = SilaClient("127.0.0.1", served.port, insecure=True)
-        assert server_name(client) == "TIAGo Labware Robot"
+        assert server_name(client) == "TIAGo Labware Robot (default lab)"
         assert not served.ca_file.exists(), "no CA is written for a plain-text deployment"
         assert_bound_only_to(served, "127.0.0.1")  # the default --host
     finally:
@@ -112,14 +112,14 @@ def test_tls_serve_answers_clients_that_trust_its_ca(tls_serve: Served) -> None:
     assert any(line.startswith("CA file for clients:") for line in tls_serve.stdout_lines)
     root_certs = tls_serve.ca_file.read_bytes()
     client = SilaClient(tls_serve.host, tls_serve.port, root_certs=root_certs)
-    assert server_name(client) == "TIAGo Labware Robot"
+    assert server_name(client) == "TIAGo Labware Robot (default lab)"
     station = SilaClient(tls_serve.host, tls_serve.port + 1, root_certs=root_certs)
     assert server_name(station).startswith("Station")
     channel = grpc.secure_channel(
         f"{tls_serve.host}:{tls_serve.port}", grpc.ssl_channel_credentials(root_certs)
     )
     with channel:
-        assert b"TIAGo Labware Robot" in raw_server_name(channel)
+        assert b"TIAGo Labware Robot (default lab)" in raw_server_name(channel)
 
 
 @pytest.mark.parametrize("how", ["system roots only", "another CA", "plain text"])

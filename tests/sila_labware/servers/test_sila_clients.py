@@ -206,3 +206,26 @@ def test_sila2_discovery_without_a_ca_file_trusts_the_announced_ca(stack: Deploy
         assert {position.Position for position in positions} == {"station_a", "station_b"}
     finally:
         client._channel.close()  # sila2 0.14 offers no public close
+
+
+def test_two_labs_on_one_network_are_told_apart_by_name(
+    stack: Deployment, tmp_path_factory: pytest.TempPathFactory
+) -> None:
+    """Two labs announce themselves at once; discovery by server name (the lab's name in it), with
+    no CA file, reaches each lab's own robot."""
+    from sila2.client import SilaClient
+
+    second = start_stack(tmp_path_factory.mktemp("second_lab"), discovery=True, lab_name="second lab")
+    try:
+        for lab, name in (
+            (stack, "TIAGo Labware Robot (default lab)"),
+            (second, "TIAGo Labware Robot (second lab)"),
+        ):
+            assert lab.robot_server().name == name
+            client = SilaClient.discover(server_name=name, timeout=20)
+            try:
+                assert client.SiLAService.ServerUUID.get() == str(lab.robot_server().server.server_uuid)
+            finally:
+                client._channel.close()  # sila2 0.14 offers no public close
+    finally:
+        second.stop()

@@ -99,7 +99,7 @@ def test_servers_use_tls_and_are_discoverable(stack: Deployment) -> None:
     with pytest.raises(Exception):  # noqa: B017 - any failure to talk plain text to a TLS server
         SilaClient(served.host, served.port, insecure=True).SiLAService.ServerName.get()
     found = SilaClient.discover(server_uuid=served.server.server_uuid, timeout=10, root_certs=ca)
-    assert found.SiLAService.ServerName.get() == "TIAGo Labware Robot"
+    assert found.SiLAService.ServerName.get() == "TIAGo Labware Robot (default lab)"
 
 
 def test_out_of_order_commands_are_invalid_command_sequence(
