@@ -7,7 +7,9 @@ implementations translate its exceptions into SiLA errors:
 
 - `CommandSequenceError` -> InvalidCommandSequence (RobotBusy for motion commands)
 - `ParameterError` -> a validation error naming the parameter
-- `TransferFailed` -> LabwareNotPicked / LabwareNotPlaced, with the robot side's message
+- `TransferFailed` -> LabwareNotPicked / LabwareNotPlaced, with the robot side's message; also
+  when the robot side reported success but the sensors do not show the plate where the command
+  put it (PLATE_SLIPPED after GetLabware, PLACE_FAILED after PutLabware)
 - `MotionFailed` -> the MobileRobotController error for its ROS error code
 
 Progress: each command reports through one `CommandProgress` (ros_bridge.progress), which maps
@@ -28,7 +30,7 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable
 
-from labware_model.holders import HotelSlot, Nest, location_text
+from labware_model.holders import UNKNOWN, HotelSlot, Location, Nest, location_text
 from labware_model.workcell import WorkcellDescription
 from ros_bridge.errors import BridgeTimeout
 from ros_bridge.goal_status import ActionGoal, ActionOutcome
@@ -159,7 +161,8 @@ class RobotController:
         report: ProgressReport | None,
     ) -> str:
         """GetLabware or PutLabware: check, match the prepared transfer, run the goal, settle the
-        inventory from what the robot observed, then raise TransferFailed if the goal failed."""
+        inventory from what the robot observed, then raise TransferFailed if the goal failed or
+        the sensors do not show its effect."""
         getting = command == "GetLabware"
         handover = self.parameters.transfer(position, sub_position, intermediate_actions)
         transfer = self.sequence.begin_get(handover) if getting else self.sequence.begin_put(handover)
@@ -175,9 +178,10 @@ class RobotController:
             progress = CommandProgress(report, self.pace.to_wall_s)
             outcome = self.goals.run(lambda: send(request, progress.step(0.0, 1.0)), command)
             labware_id = transfer.labware_id or str(getattr(outcome.result, "labware_id", ""))
-            self._settle(labware_id, transfer, outcome, expect_aboard=getting)
+            location = self._settle(labware_id, transfer, outcome, expect_aboard=getting)
             if not outcome.success:
                 raise TransferFailed(outcome.error_code, _describe_failure(command, outcome))
+            self._refuse_unseen_effect(command, labware_id, transfer, location)
             return labware_id
         finally:
             self.sequence.finish_transfer()
@@ -267,12 +271,12 @@ class RobotController:
 
     def _settle(
         self, labware_id: str, transfer: PreparedTransfer, outcome: ActionOutcome, expect_aboard: bool
-    ) -> None:
-        """Record where the plate really is, after the robot side reported the outcome."""
+    ) -> Location | None:
+        """Record where the plate really is, after the robot side reported the outcome; returns
+        that location (None without a labware id: then the inventory is not updated)."""
         if not labware_id:
             logger.warning("transfer at %s without a labware id: inventory not updated", transfer.handover)
-            return
-        expected_slot = HotelSlot(transfer.internal_position)
+            return None
 
         def shows_outcome(status: RobotStatus) -> bool:
             aboard = labware_id in status.onboard_labware_ids
@@ -288,17 +292,27 @@ class RobotController:
             try:
                 self.link.wait_for_nest(transfer.handover, True, self.waits.settle_s)
             except BridgeTimeout:
-                logger.warning("PutLabware succeeded but the sensor of %s sees no plate", transfer.handover)
-        location = self.inventory.settle(
+                pass  # the sensors do not show the place: _refuse_unseen_effect says so
+        return self.inventory.settle(
             labware_id, transfer.labware_type, transfer.handover, status, self.link.nest_readings()
         )
-        if outcome.success and expect_aboard and location != expected_slot:
-            logger.warning(
-                "GetLabware succeeded but %s is at %s, not %s",
-                labware_id,
-                location_text(location),
-                location_text(expected_slot),
-            )
+
+    def _refuse_unseen_effect(
+        self, command: str, labware_id: str, transfer: PreparedTransfer, location: Location | None
+    ) -> None:
+        """A transfer the robot side reported done must show in the sensors as well: the plate in
+        the prepared hotel slot after GetLabware, in the nest after PutLabware; else TransferFailed."""
+        getting = command == "GetLabware"
+        expected: Location = HotelSlot(transfer.internal_position) if getting else transfer.handover
+        if location is None or location == expected:  # None: no id, nothing to look for
+            return
+        where = "nowhere a sensor sees" if location == UNKNOWN else location_text(location)
+        code = "PLATE_SLIPPED" if getting else "PLACE_FAILED"
+        raise TransferFailed(
+            code,
+            f"{command} failed ({code}): the robot side reported success, but the sensors put "
+            f"{labware_id} at {where}, not {location_text(expected)}",
+        )
 
     def _refuse_occupied_destination(self, handover: Nest) -> None:
         """Before any motion: a nest whose sensor sees a plate cannot take another one."""

@@ -1,4 +1,5 @@
-"""Test and fault injection for the sim node: hide a marker, take a plate away, drop one mid-drive.
+"""Test and fault injection for the sim node: hide a marker, take a plate away, drop one mid-drive,
+knock one out of a nest the robot just released it into.
 
 Why: a test of MARKER_NOT_FOUND needs a real occlusion in the rendered image, not a flag in
 the perception code. The occluder is a visual-only panel (no collision shape, so it cannot push
@@ -64,22 +65,30 @@ DRIVING_SPEED_M_S = 0.2  # the base counts as driving (not turning on the spot) 
 
 
 class PlateFaults:
-    """Physical plate faults: a plate taken away from its place, or lost from the hotel mid-drive.
+    """Physical plate faults: a plate taken away from its place, lost from the hotel mid-drive, or
+    knocked out of a nest right after a release.
 
     ``remove(sim, plate)`` moves the plate onto the floor far from every station (as if someone
-    took it); ``arm_drop(plate)`` makes the plate slip out of the hotel the next time the base
-    drives, and physics drops it on the floor beside the robot; ``restore(sim)`` puts every plate
-    moved or dropped this way back where the world file puts it (if that place is free), so a test
-    can go on. Nothing here tells the robot software: it must find out from its sensors.
-    Uses the simulation's own (true) world. Runs on: the sim thread.
+    took it, out of the gripper too); ``arm_drop(plate)`` makes the plate slip out of the hotel the
+    next time the base drives, and physics drops it on the floor beside the robot;
+    ``arm_knock(plate)`` takes the plate away (as `remove`) the moment a gripper that held it starts
+    to let go of it in a nest; ``restore(sim)`` puts every plate moved or dropped this way back where the
+    world file puts it (if that place is free), so a test can go on. Nothing here tells the robot
+    software: it must find out from its sensors. Uses the simulation's own (true) world.
+    Runs on: the sim thread.
     """
 
     def __init__(self) -> None:
         self.drop_armed = ""
+        self.knock_armed = ""
+        self.knock_seen_held = False
         self.faulted: set[str] = set()
 
     def remove(self, sim: Any, labware_id: str) -> None:
         body = self._body(sim, labware_id)
+        for gripper in sim.grippers.values():
+            if gripper.attached_id == labware_id:
+                gripper.detach()  # a hand pulling the plate out breaks the grip
         corner = sim.world.floor_size / 2 - PARKING_MARGIN_M
         labware = sim.scene.plate_types[labware_id]
         _teleport(sim, body, [corner, corner, labware.height / 2 + 0.001], [0, 0, 0, 1])
@@ -116,9 +125,32 @@ class PlateFaults:
         log.info("plate %s slipped out of hotel slot %d mid-drive (fault injection)", labware_id, slot)
         return True
 
+    def arm_knock(self, sim: Any, labware_id: str) -> None:
+        self._body(sim, labware_id)
+        self.knock_armed, self.knock_seen_held = labware_id, False
+        log.info("plate %s will be knocked out of the nest it is released in (fault injection)", labware_id)
+
+    def knock_if_released(self, sim: Any) -> bool:
+        """Called on the sim thread after every batch of steps while a knock is armed: once a gripper
+        held the plate and let go of it (the release starts by dropping the travel attach, before the
+        fingers open) in a nest, take it away; True when done."""
+        labware_id = self.knock_armed
+        if not labware_id:
+            return True
+        if any(gripper.attached_id == labware_id for gripper in sim.grippers.values()):
+            self.knock_seen_held = True
+            return False
+        in_nest = any(reading.labware_id == labware_id for reading in sim.nest_readings())
+        if not (self.knock_seen_held and in_nest):
+            return False
+        self.knock_armed = ""
+        log.info("plate %s knocked out of its nest after the release (fault injection)", labware_id)
+        self.remove(sim, labware_id)
+        return True
+
     def restore(self, sim: Any) -> None:
         """Put faulted plates back at their world-file nests (skipped where a plate already sits)."""
-        self.drop_armed = ""
+        self.drop_armed = self.knock_armed = ""
         for plate, holder in sim.world.plates.items():
             if plate.labware_id not in self.faulted or not isinstance(holder, Nest):
                 continue

@@ -3,7 +3,7 @@
 Why together: both read where plates rest from PyBullet. The presence sensors (one per nest, one
 per hotel pocket) report what a real sensor could (a plate there, and which one: see the README's
 modelling notes); ``check_placement`` is ground truth and serves success checks only, never robot
-control. Lives on the sim thread.
+control; whether a plate is seated, and every limit, comes from `seating`. Lives on the sim thread.
 """
 
 from __future__ import annotations
@@ -20,13 +20,8 @@ from tiago_sim import transforms as tf
 from tiago_sim.lab.world import World
 from tiago_sim.physics.robot_body import RobotBody
 from tiago_sim.physics.scene import plate_bottom_pose
+from tiago_sim.physics.seating import PoseInNest, SeatingLimits
 
-# A delivered plate rests in its nest when it is within the nest's clearance + this per axis and
-# under the other limits (the success check of every transfer).
-PLACED_BEYOND_CLEARANCE_MM = 1.0
-PLACED_HEIGHT_TOLERANCE_MM = 2.0
-PLACED_YAW_TOLERANCE_DEG = 2.0
-PLACED_TILT_TOLERANCE_DEG = 1.0
 NEST_SENSOR_RANGE = 0.02  # m: presence sensor sees a plate whose centre is this close to the site
 
 
@@ -103,25 +98,11 @@ class PlateSensing:
         if nest is None:
             return PlacementCheck(True, False, math.nan, math.nan, location)
         site = self._world.station(nest.station)
-        offset = self._site_offset(site.T_world_site(nest.sub_position), labware_id)
-        position_error = float(np.linalg.norm(offset[:2, 3]))
-        yaw_error = abs(tf.wrap_angle(tf.yaw_of(offset)))
-        tilt = tf.rotation_angle(np.eye(3), offset[:3, :3]) - yaw_error
-        margin_mm = 1000.0 * site.nest_clearance + PLACED_BEYOND_CLEARANCE_MM
-        x_mm, y_mm, z_mm = (1000.0 * float(v) for v in offset[:3, 3])
-        missed = [
-            f"{label} {value:.1f} {unit} (limit {limit:.1f})"
-            for label, value, unit, limit in (
-                ("off along the nest's long side by", abs(x_mm), "mm", margin_mm),
-                ("off across the nest by", abs(y_mm), "mm", margin_mm),
-                ("raised" if z_mm > 0 else "sunk", abs(z_mm), "mm", PLACED_HEIGHT_TOLERANCE_MM),
-                ("turned", math.degrees(yaw_error), "deg", PLACED_YAW_TOLERANCE_DEG),
-                ("tilted", abs(math.degrees(tilt)), "deg", PLACED_TILT_TOLERANCE_DEG),
-            )
-            if value >= limit
-        ]
-        outside = ", ".join(missed)
-        return PlacementCheck(True, not missed, position_error, float(yaw_error), location, outside)
+        labware = self._scene.plate_types[labware_id]
+        pose = PoseInNest.of(self._site_offset(site.T_world_site(nest.sub_position), labware_id), labware)
+        missed = SeatingLimits.for_nest(labware, site.nest_clearance).missed(pose)
+        position_error = math.hypot(pose.x, pose.y)
+        return PlacementCheck(True, not missed, position_error, abs(pose.yaw), location, ", ".join(missed))
 
     def _locate(self, labware_id: str) -> Location:
         for _side, gripper in self._grippers.items():

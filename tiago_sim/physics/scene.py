@@ -29,6 +29,7 @@ log = logging.getLogger(__name__)
 PLATE_FRICTION = 1.0
 PLATE_SPINNING_FRICTION = 0.02
 NEST_LEAD_IN = 0.006  # per side, 45 deg from the bench top: the opening is this much wider than the pocket
+NEST_LEAD_IN_SLOPE = 1.0  # rise per run of the lead-in ramps: 45 deg (the rotations in nest_boxes)
 NEST_RAMP_FOOT = 0.001  # the ramp runs on this far below the bench top: no edge is left at its foot
 NEST_LEG_LENGTH = 0.015  # bracket legs run this far in from each corner
 NEST_FRICTION = 0.15  # polished lead-ins: with the plate's 1.0, the pair's friction is 0.15

@@ -11,6 +11,18 @@ sub-goals, so every rclpy object is used on that thread only. Feedback aggregate
 sub-action's progress over the plan (estimated durations) and goes out at `feedback_hz`.
 Cancel cancels the running sub-action; the plate is then left where that step left it (nest,
 hotel or gripper, as /robot_state reports). An abort carries the sub-action's code and message.
+
+A step is done when its sensors say so: after a step with a post-condition (plans.Expect), the
+task waits at most `post_check_s` for a sensor report read after the step ended that shows the
+plate where it must be; otherwise it fails with the step's code (PLATE_SLIPPED, PLACE_FAILED)
+naming what the sensor saw, and after those (and GRASP_FAILED) the arm backs out empty and tucks
+(plans.retreat_steps).
+
+Every wait is bounded: a sub-goal that gives no result within `step_timeout_s` is cancelled and
+the task aborts with NAVIGATION_FAILED (navigate, undock) or MOTION_FAILED, naming the step; a
+sub-goal not accepted within `server_wait_s` and a cancel not answered within `cancel_wait_s`
+abort with INTERNAL; /describe_workcell gets `describe_attempts` requests of `describe_timeout_s`
+each, then the goal aborts with INTERNAL saying so.
 """
 
 from __future__ import annotations
@@ -40,16 +52,21 @@ from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.task import Future
 
-from labware_model.workcell import StationDescription, WorkcellDescription
+from labware_model.workcell import WorkcellDescription
 from tiago_sim.node_main import spin_node
 from tiago_sim.sequencer.plans import (
+    RETREAT_AFTER,
     STATE_REFUSALS,
     Step,
     TaskRefused,
     get_plan,
+    labware_id_at_source,
     put_plan,
-    retreat_after_empty_grasp,
+    retreat_steps,
 )
+from tiago_sim.sequencer.postconditions import topic_of, unmet
+from tiago_sim.sequencer.task_run import StepFailed, TaskRun
+from tiago_sim.sequencer.waits import describe_workcell, sleep, within
 
 log = logging.getLogger("tiago_sim.sequencer")
 
@@ -61,51 +78,13 @@ SUB_ACTIONS = {
     "gripper": (Gripper, "/gripper"),
     "marker_motion": (MarkerMotion, "/marker_motion"),
 }
-
-
-class StepFailed(Exception):
-    def __init__(self, code: str, message: str) -> None:
-        super().__init__(f"{code}: {message}")
-        self.code = code
-        self.message = message
-
-
-class TaskRun:
-    """Progress bookkeeping of one task goal (lives on the executor thread)."""
-
-    def __init__(
-        self, goal_handle: Any, feedback_type: type, plan: list[Step], estimates: dict[str, float]
-    ) -> None:
-        self.goal_handle = goal_handle
-        self.feedback_type = feedback_type
-        self.durations = [max(estimates.get(step.action, 3.0), 0.1) for step in plan]
-        self.total = sum(self.durations)
-        self.index = 0
-        self.step_progress = 0.0
-        self.step_remaining_s: float | None = None
-        self.phase = "starting"
-        self.sub_goal: Any = None  # ClientGoalHandle of the running sub-action
-
-    def progress(self) -> float:
-        done = sum(self.durations[: self.index])
-        current = self.durations[self.index] * self.step_progress if self.index < len(self.durations) else 0.0
-        return min((done + current) / self.total, 1.0) if self.total else 1.0
-
-    def remaining_s(self) -> float:
-        later = sum(self.durations[self.index + 1 :])
-        if self.index >= len(self.durations):
-            return 0.0
-        current = self.step_remaining_s
-        if current is None:
-            current = self.durations[self.index] * (1.0 - self.step_progress)
-        return current + later
-
-    def publish(self) -> None:
-        feedback = self.feedback_type()
-        feedback.progress = float(self.progress())
-        feedback.phase = self.phase
-        feedback.remaining_time_s = float(self.remaining_s())
-        self.goal_handle.publish_feedback(feedback)
+# The task's code when a sub-goal gives no result within step_timeout_s (else MOTION_FAILED).
+TIMEOUT_CODES = {"navigate": ErrorCodes.NAVIGATION_FAILED, "undock": ErrorCodes.NAVIGATION_FAILED}
+PARAMETERS = tuple(  # every one in sequencer.yaml, besides estimates_s
+    "arm feedback_hz server_wait_s step_timeout_s cancel_wait_s post_check_s describe_timeout_s "
+    "describe_attempts state_max_age_s".split()
+)
+STATE_TOPICS = {"robot": "/robot_state", "stations": "/station_states"}
 
 
 class Sequencer:
@@ -113,7 +92,7 @@ class Sequencer:
 
     def __init__(self, node: Node, params: dict[str, Any]) -> None:
         self.node = node
-        for name in ("arm", "feedback_hz", "server_wait_s", "step_timeout_s", "state_max_age_s"):
+        for name in PARAMETERS:
             node.declare_parameter(name, params[name])
         for action, seconds in params["estimates_s"].items():
             node.declare_parameter(f"estimates_s.{action}", float(seconds))
@@ -123,6 +102,8 @@ class Sequencer:
         self.robot_state: RobotState | None = None
         self.station_states: StationStates | None = None
         self.state_times: dict[str, float] = {}
+        self.idle_report_at = -1e9  # when the last /robot_state showing no goal running arrived
+        self.report_arrived = Future()  # a post-condition check waits on it for the next state message
         qos = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
         node.create_subscription(RobotState, "/robot_state", self._on_robot_state, qos)
         node.create_subscription(StationStates, "/station_states", self._on_station_states, qos)
@@ -149,10 +130,18 @@ class Sequencer:
     def _on_robot_state(self, message: RobotState) -> None:
         self.robot_state = message
         self.state_times["robot"] = time.monotonic()
+        if message.state not in (RobotState.STATE_MANIPULATING, RobotState.STATE_NAVIGATING):
+            self.idle_report_at = self.state_times["robot"]
+        self._report_in()
 
     def _on_station_states(self, message: StationStates) -> None:
         self.station_states = message
         self.state_times["stations"] = time.monotonic()
+        self._report_in()
+
+    def _report_in(self) -> None:
+        if not self.report_arrived.done():
+            self.report_arrived.set_result(None)
 
     def _feedback_tick(self) -> None:
         if self.active is not None:
@@ -164,37 +153,18 @@ class Sequencer:
             run.sub_goal.cancel_goal_async()
         return CancelResponse.ACCEPT
 
-    async def _sleep(self, seconds: float) -> None:
-        """Wait without blocking the executor (a one-shot timer completes a future)."""
-        done = Future()
-
-        def fire() -> None:
-            timer.cancel()
-            done.set_result(True)
-
-        timer = self.node.create_timer(seconds, fire)
-        await done
-        self.node.destroy_timer(timer)
-
     async def _wait_ready(self, what: str, is_ready: Any) -> None:
         deadline = time.monotonic() + float(self.param("server_wait_s"))
         while not is_ready():
             if time.monotonic() > deadline:
                 raise StepFailed(ErrorCodes.INTERNAL, f"robot not available: {what} does not answer")
-            await self._sleep(0.1)
+            await sleep(self.node, 0.1)
 
     async def _describe(self) -> WorkcellDescription:
         if self.workcell is None:
             await self._wait_ready("/describe_workcell", self.describe_client.service_is_ready)
-            response = await self.describe_client.call_async(DescribeWorkcell.Request())
-            self.workcell = WorkcellDescription(
-                stations=tuple(
-                    StationDescription(s.name, int(s.sub_positions), s.poi) for s in response.stations
-                ),
-                hotel_slots=int(response.hotel_slots),
-                pois=tuple(response.pois),
-                dock_poi=response.dock_poi,
-            )
+            attempts, timeout_s = self.param("describe_attempts"), self.param("describe_timeout_s")
+            self.workcell = await describe_workcell(self.node, self.describe_client, attempts, timeout_s)
         return self.workcell
 
     def _fresh_states(self) -> tuple[RobotState, StationStates]:
@@ -238,7 +208,10 @@ class Sequencer:
                 plan = await self._plan(goal_handle.request, make_plan, arrived=time.monotonic())
             except (TaskRefused, StepFailed) as refusal:
                 return self._finish(goal_handle, result, refusal.code, refusal.message)
-            result.labware_id = self._labware_id(goal_handle.request, kind is PutLabware)
+            from_hotel = kind is PutLabware
+            result.labware_id = labware_id_at_source(
+                goal_handle.request, self.robot_state, self.station_states, from_hotel
+            )
             estimates = {a: float(self.param(f"estimates_s.{a}")) for a in SUB_ACTIONS}
             run = TaskRun(goal_handle, kind.Feedback, plan, estimates)
             self.active = run
@@ -254,12 +227,13 @@ class Sequencer:
                     if goal_handle.is_cancel_requested:
                         raise StepFailed(ErrorCodes.CANCELED, f"canceled before {step.describe()}")
                     run.publish()  # a new phase is news: clients see it at once, not at the next tick
-                    await self._run_step(run, step)
+                    await self._run_step(run, step, f"step {index + 1} of {len(plan)}")
+                    await self._check_post(step, result.labware_id)
                 run.index, run.phase = len(plan), "done"
                 run.publish()  # the last word is progress 1.0
                 return self._finish(goal_handle, result, "", "done")
             except StepFailed as failure:
-                if failure.code == ErrorCodes.GRASP_FAILED:
+                if failure.code in RETREAT_AFTER:
                     await self._retreat(run, plan)
                 return self._finish(goal_handle, result, failure.code, failure.message)
             except Exception as error:  # noqa: BLE001 - every goal ends with a result
@@ -271,30 +245,47 @@ class Sequencer:
         return execute
 
     async def _retreat(self, run: TaskRun, plan: list[Step]) -> None:
-        """Best effort after an empty grasp: bring the arm out of the nest or pocket and tuck it;
-        the task still ends with GRASP_FAILED, whatever happens here."""
-        for step in retreat_after_empty_grasp(plan, run.index):
+        """Best effort after the gripper was left empty: bring the arm out of the nest or pocket and
+        tuck it; the task still ends with its failure, whatever happens here."""
+        for step in retreat_steps(plan, run.index):
             try:
                 run.phase = step.phase
-                await self._run_step(run, step)
+                run.publish()
+                await self._run_step(run, step, "retreat")
             except StepFailed as failure:
-                log.warning("retreat after an empty grasp stopped: %s", failure.message)
+                log.warning("retreat after the failure stopped: %s", failure.message)
                 return
 
-    def _labware_id(self, request: Any, from_hotel: bool) -> str:
-        """The plate's id as the robot's sensors report it at the source, else the one asked for."""
-        if from_hotel and self.robot_state is not None:
-            for slot in self.robot_state.hotel:
-                if slot.index == request.internal_position and slot.labware_id:
-                    return slot.labware_id
-        if not from_hotel and self.station_states is not None:
-            for nest in self.station_states.nests:
-                same = nest.station == request.handover_position and nest.sub_position == request.sub_position
-                if same and nest.labware_id:
-                    return nest.labware_id
-        return request.labware_id
+    async def _check_post(self, step: Step, labware_id: str) -> None:
+        """The step's post-condition, read from sensor reports taken after the step ended.
 
-    async def _run_step(self, run: TaskRun, step: Step) -> None:
+        Which reports those are: a /robot_state received after the result that shows the robot
+        idle was read between this goal's end and the next goal's start (the robot reports
+        "manipulating" or "navigating" while a goal runs, and the sensors and that state come from
+        one instant); /station_states from the same instant or later arrive after it. A report
+        merely received after the result may have been read before the step ended."""
+        expect = step.post
+        if expect is None:
+            return
+        ended, topic = time.monotonic(), topic_of(expect)
+        deadline, idle_at = ended + float(self.param("post_check_s")), None
+        seen = ""
+        while True:
+            if idle_at is None and self.idle_report_at > ended:
+                idle_at = self.idle_report_at
+            if idle_at is not None and self.state_times.get(topic, -1e9) >= idle_at:
+                seen = unmet(expect, labware_id, self.robot_state, self.station_states)
+                if not seen:
+                    return
+            if time.monotonic() >= deadline:
+                if not seen:
+                    no_report = f"no {STATE_TOPICS[topic]} read after the step within {deadline - ended:g} s"
+                    raise StepFailed(ErrorCodes.INTERNAL, f"after {step.phase}: {no_report}")
+                raise StepFailed(expect.code, f"after {step.phase}: {seen} ({step.describe()})")
+            self.report_arrived = Future()  # completed by the next state message
+            await within(self.node, self.report_arrived, deadline - time.monotonic())
+
+    async def _run_step(self, run: TaskRun, step: Step, which: str) -> None:
         kind, _topic = SUB_ACTIONS[step.action]
         client = self.clients[step.action]
         await self._wait_ready(SUB_ACTIONS[step.action][1], client.server_is_ready)
@@ -308,15 +299,22 @@ class Sequencer:
             if message.feedback.phase:
                 run.phase = f"{step.phase}: {message.feedback.phase}"
 
-        log.info("step %d: %s", run.index + 1, step.describe())
-        sub_goal = await client.send_goal_async(goal, feedback_callback=on_feedback)
+        log.info("%s: %s", which, step.describe())
+        sent = client.send_goal_async(goal, feedback_callback=on_feedback)
+        if not await within(self.node, sent, float(self.param("server_wait_s"))):
+            # an answer that comes after all must not leave a goal running that nobody waits for
+            sent.add_done_callback(lambda done: done.result().accepted and done.result().cancel_goal_async())
+            raise StepFailed(ErrorCodes.INTERNAL, f"{which} ({step.describe()}): the goal was not answered")
+        sub_goal = sent.result()
         if not sub_goal.accepted:
             raise StepFailed(ErrorCodes.INTERNAL, f"{step.describe()}: goal rejected")
         run.sub_goal = sub_goal
         if run.goal_handle.is_cancel_requested:
             sub_goal.cancel_goal_async()
-        response = await sub_goal.get_result_async()
-        run.sub_goal = None
+        try:
+            response = await self._result_within_step_timeout(sub_goal, step, which)
+        finally:
+            run.sub_goal = None
         sub_result = response.result
         if response.status == GoalStatus.STATUS_CANCELED or sub_result.error_code == ErrorCodes.CANCELED:
             raise StepFailed(ErrorCodes.CANCELED, f"canceled during {step.describe()}: {sub_result.message}")
@@ -327,6 +325,22 @@ class Sequencer:
         if step.expect_holding and not sub_result.holding:
             raise StepFailed(ErrorCodes.GRASP_FAILED, f"{step.describe()}: nothing between the fingers")
         run.step_progress, run.step_remaining_s = 1.0, 0.0
+
+    async def _result_within_step_timeout(self, sub_goal: Any, step: Step, which: str) -> Any:
+        """The sub-goal's result; past `step_timeout_s` the sub-goal is cancelled and the step fails."""
+        timeout_s = float(self.param("step_timeout_s"))
+        result = sub_goal.get_result_async()
+        if await within(self.node, result, timeout_s):
+            return result.result()
+        log.warning("%s (%s): no result within %g s, cancelling it", which, step.describe(), timeout_s)
+        sub_goal.cancel_goal_async()
+        cancel_wait_s = float(self.param("cancel_wait_s"))
+        ended = await within(self.node, result, cancel_wait_s)
+        code = TIMEOUT_CODES.get(step.action, ErrorCodes.MOTION_FAILED) if ended else ErrorCodes.INTERNAL
+        after = "cancelled" if ended else f"cancelled, and it did not end within {cancel_wait_s:g} s either"
+        raise StepFailed(
+            code, f"{which} ({step.phase}: {step.describe()}) timed out after {timeout_s:g} s: {after}"
+        )
 
     @staticmethod
     def _finish(goal_handle: Any, result: Any, code: str, message: str) -> Any:
@@ -345,14 +359,7 @@ class Sequencer:
 
 def load_params(path: Path) -> dict[str, Any]:
     params = yaml.safe_load(Path(path).read_text())
-    missing = {
-        "arm",
-        "feedback_hz",
-        "server_wait_s",
-        "step_timeout_s",
-        "state_max_age_s",
-        "estimates_s",
-    } - set(params)
+    missing = {*PARAMETERS, "estimates_s"} - set(params)
     if missing:
         raise ValueError(f"{path}: missing {', '.join(sorted(missing))}")
     return params

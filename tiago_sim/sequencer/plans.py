@@ -1,9 +1,22 @@
 """The sub-action plans of GetLabware and PutLabware, and the checks before a plan starts.
 
-Pure data: a plan is a list of Steps (which action, which goal fields, an estimated duration),
-built from the goal, the workcell /describe_workcell reported (a `WorkcellDescription` of the
-labware model) and what the robot and stations report. The sequencer node runs it.
-Safe on any thread.
+Pure data: a plan is a list of Steps (which action, which goal fields, an estimated duration,
+and what a sensor must show once the step has ended), built from the goal, the workcell
+/describe_workcell reported (a `WorkcellDescription` of the labware model) and what the robot and
+stations report. The sequencer node runs it and checks each step's `post` against /robot_state
+and /station_states (see `postconditions`). Safe on any thread.
+
+Post-conditions, at the points where a plate changes hands or has been carried:
+
+| step | sensor | error when it fails |
+|---|---|---|
+| grasp (gripper closed) | the gripper's own result: something between the fingers | GRASP_FAILED |
+| lifting out of the nest or pocket; the last carrying step | gripper holds the plate | PLATE_SLIPPED |
+| release into the hotel (GetLabware) | hotel slot sees the plate | PLACE_FAILED |
+| arm tucked (GetLabware's last step) | hotel slot still sees it | PLATE_SLIPPED |
+| final approach (PutLabware, before reaching into the hotel) | hotel slot still sees it | PLATE_SLIPPED |
+| release into the nest (PutLabware) | nest sensor sees the plate | PLACE_FAILED |
+| arm tucked (PutLabware's last step) | nest sensor still sees it | PLACE_FAILED |
 """
 
 from __future__ import annotations
@@ -13,7 +26,7 @@ from typing import Any
 
 from labware_interfaces.msg import ErrorCodes, RobotState
 
-from labware_model.holders import HotelSlot, Nest
+from labware_model.holders import GRIPPER, Gripper, HotelSlot, Nest
 from labware_model.workcell import WorkcellDescription
 
 # Refusals that rest on what the state topics say (a slot or nest full or empty), not on the goal.
@@ -32,11 +45,21 @@ class TaskRefused(Exception):
 
 
 @dataclass(frozen=True)
+class Expect:
+    """What a sensor must show once a step has ended: the task's plate in `holder` (the gripper, a
+    hotel slot or a nest); `code` is the ErrorCodes value the task fails with when it does not."""
+
+    holder: Gripper | HotelSlot | Nest
+    code: str
+
+
+@dataclass(frozen=True)
 class Step:
     action: str  # undock, navigate, play_motion, gripper, marker_motion
     goal: dict[str, Any] = field(default_factory=dict)
     phase: str = ""
     expect_holding: bool | None = None  # gripper close: True means "must hold a plate"
+    post: Expect | None = None  # checked on the state topics once the step has ended
 
     def describe(self) -> str:
         details = " ".join(f"{k}={v}" for k, v in self.goal.items() if k != "arm")
@@ -90,6 +113,20 @@ def hotel_slot_state(robot_state: Any, slot: HotelSlot) -> Any | None:
     return None
 
 
+def labware_id_at_source(request: Any, robot_state: Any, station_states: Any, from_hotel: bool) -> str:
+    """The plate's id as the robot's sensors report it at the source (the goal's hotel slot, or its
+    nest), else the one the goal asked for."""
+    if from_hotel and robot_state is not None:
+        slot = hotel_slot_state(robot_state, HotelSlot(request.internal_position))
+        if slot is not None and slot.labware_id:
+            return slot.labware_id
+    if not from_hotel and station_states is not None:
+        nest = nest_state(station_states, Nest(request.handover_position, request.sub_position))
+        if nest is not None and nest.labware_id:
+            return nest.labware_id
+    return request.labware_id
+
+
 def travel_steps(robot_state: Any, poi: str) -> list[Step]:
     """Arm tucked, off the dock, drive to the station's POI - whatever of it is needed.
 
@@ -126,6 +163,7 @@ def get_plan(
             ErrorCodes.GRASP_FAILED, f"no plate at source {goal.handover_position}:{goal.sub_position}"
         )
     site, hotel = _goal_fields(checked, arm)
+    held = Expect(GRIPPER, ErrorCodes.PLATE_SLIPPED)
     return [
         *travel_steps(robot_state, checked.poi),
         Step("marker_motion", {**site, "target": "work_pose"}, "final approach"),
@@ -134,12 +172,22 @@ def get_plan(
         Step("marker_motion", {**site, "target": "site_approach"}, "approach"),
         Step("marker_motion", {**site, "target": "site"}, "reaching"),
         Step("gripper", {"command": "close", "arm": arm}, "grasp", expect_holding=True),
-        Step("marker_motion", {**site, "target": "site_approach"}, "lifting"),
+        Step("marker_motion", {**site, "target": "site_approach"}, "lifting", post=held),
         Step("play_motion", {"motion_name": "NestApproach", **hotel}, "to hotel"),
-        Step("play_motion", {"motion_name": "Nest", **hotel}, "into hotel"),
-        Step("gripper", {"command": "open", "arm": arm}, "release"),
+        Step("play_motion", {"motion_name": "Nest", **hotel}, "into hotel", post=held),
+        Step(
+            "gripper",
+            {"command": "open", "arm": arm},
+            "release",
+            post=Expect(checked.hotel_slot, ErrorCodes.PLACE_FAILED),
+        ),
         Step("play_motion", {"motion_name": "NestApproach", **hotel}, "retract"),
-        Step("play_motion", {"motion_name": "Tuck", "arm": arm}, "arm tucked"),
+        Step(
+            "play_motion",
+            {"motion_name": "Tuck", "arm": arm},
+            "arm tucked",
+            post=Expect(checked.hotel_slot, ErrorCodes.PLATE_SLIPPED),
+        ),
     ]
 
 
@@ -159,36 +207,66 @@ def put_plan(
     if slot is None or not slot.labware_id:
         raise TaskRefused(ErrorCodes.SLOT_EMPTY, f"hotel slot {goal.internal_position} holds no plate")
     site, hotel = _goal_fields(checked, arm)
+    held = Expect(GRIPPER, ErrorCodes.PLATE_SLIPPED)
+    placed = Expect(checked.nest, ErrorCodes.PLACE_FAILED)
     return [
         *travel_steps(robot_state, checked.poi),
-        Step("marker_motion", {**site, "target": "work_pose"}, "final approach"),
+        Step(
+            "marker_motion",
+            {**site, "target": "work_pose"},
+            "final approach",
+            post=Expect(checked.hotel_slot, ErrorCodes.PLATE_SLIPPED),
+        ),
         Step("gripper", {"command": "open", "arm": arm}, "opening"),
         Step("play_motion", {"motion_name": "NestApproach", **hotel}, "to hotel"),
         Step("play_motion", {"motion_name": "Nest", **hotel}, "into hotel"),
         Step("gripper", {"command": "close", "arm": arm}, "grasp", expect_holding=True),
-        Step("play_motion", {"motion_name": "NestApproach", **hotel}, "lifting"),
+        Step("play_motion", {"motion_name": "NestApproach", **hotel}, "lifting", post=held),
         Step("marker_motion", {**site, "target": "site_approach"}, "approach"),  # via the carry height
-        Step("marker_motion", {**site, "target": "site"}, "placing"),
-        Step("gripper", {"command": "open", "arm": arm}, "release"),
+        Step("marker_motion", {**site, "target": "site"}, "placing", post=held),
+        Step("gripper", {"command": "open", "arm": arm}, "release", post=placed),
         Step("marker_motion", {**site, "target": "site_approach"}, "retract"),
-        Step("play_motion", {"motion_name": "Tuck", "arm": arm}, "arm tucked"),
+        Step("play_motion", {"motion_name": "Tuck", "arm": arm}, "arm tucked", post=placed),
     ]
 
 
-def retreat_after_empty_grasp(plan: list[Step], grasp_index: int) -> list[Step]:
-    """After a grasp that closed on nothing: open, back out along the plan's own lift step, tuck.
+# Task errors after which the gripper is empty and the arm may stand in a nest or a hotel pocket.
+RETREAT_AFTER = frozenset({ErrorCodes.GRASP_FAILED, ErrorCodes.PLATE_SLIPPED, ErrorCodes.PLACE_FAILED})
 
-    Why: the arm reached its target, so the way it came in is clear; left there it stands in the
-    nest, in front of the marker the next task must see first (seen: MARKER_NOT_FOUND after a plate
-    was taken away mid-GetLabware). Empty when the plan has no lift step after the grasp.
+
+def way_out(step: Step) -> Step | None:
+    """The step that backs the arm out of where `step` put it: from a nest (marker_motion to the
+    site) to the site's approach, from a hotel pocket (Nest) to its approach; None elsewhere."""
+    if step.action == "marker_motion" and step.goal.get("target") == "site":
+        return Step("marker_motion", {**step.goal, "target": "site_approach"}, "backing out")
+    if step.action == "play_motion" and step.goal.get("motion_name") == "Nest":
+        return Step("play_motion", {**step.goal, "motion_name": "NestApproach"}, "backing out")
+    return None
+
+
+def _moves_the_arm(step: Step) -> bool:
+    """Play motions, and marker motions of the tool (the final approach to the work pose moves the base)."""
+    return step.action == "play_motion" or (
+        step.action == "marker_motion" and step.goal.get("target") != "work_pose"
+    )
+
+
+def retreat_steps(plan: list[Step], failed_index: int) -> list[Step]:
+    """After a failure at plan[failed_index] that left the gripper empty (`RETREAT_AFTER`): open,
+    back out of the nest or pocket the last arm motion went into, tuck.
+
+    Why: the arm reached its last target, so the way it came in is clear; left there it stands in
+    the nest, in front of the marker the next task must see first (seen: MARKER_NOT_FOUND after a
+    plate was taken away mid-GetLabware). Empty when no arm motion ran, or the last one tucked it.
     """
-    grasp = plan[grasp_index]
-    arm = grasp.goal.get("arm", "")
-    lift = plan[grasp_index + 1] if grasp_index + 1 < len(plan) else None
-    if lift is None or lift.action not in ("marker_motion", "play_motion"):
+    arm_steps = [step for step in plan[: failed_index + 1] if _moves_the_arm(step)]
+    last = arm_steps[-1] if arm_steps else None
+    if last is None or last.goal.get("motion_name") == "Tuck":
         return []
+    arm = last.goal.get("arm", "")
+    back_out = way_out(last)
     return [
-        Step("gripper", {"command": "open", "arm": arm}, "releasing after an empty grasp"),
-        Step(lift.action, dict(lift.goal), "backing out"),
+        Step("gripper", {"command": "open", "arm": arm}, "releasing after the failure"),
+        *([back_out] if back_out is not None else []),
         Step("play_motion", {"motion_name": "Tuck", "arm": arm}, "arm tucked"),
     ]

@@ -13,8 +13,9 @@ ROS parameters (changeable at runtime): ``pois.<name>`` = [x, y, yaw] (from the 
 ``idle_realtime_factor``, and - for tests only, as fault injection (tiago_sim.measuring.fault_injection) -
 ``fault.occlude_marker``: a station name whose marker gets hidden behind a visual-only panel
 (empty: none); ``fault.remove_plate``: a plate id taken away onto the floor far from every station;
-``fault.drop_plate``: a plate id that slips out of the hotel during the next drive. Setting either
-plate fault to empty puts faulted plates back at their world-file nests.
+``fault.drop_plate``: a plate id that slips out of the hotel during the next drive;
+``fault.knock_plate``: a plate id taken away the moment the gripper releases it in a nest. Setting
+any plate fault to empty puts faulted plates back at their world-file nests.
 """
 
 from __future__ import annotations
@@ -46,6 +47,7 @@ from tiago_sim.sim_node.sim_thread import SimThread
 
 log = logging.getLogger("tiago_sim.sim_node")
 
+PLATE_FAULTS = ("fault.remove_plate", "fault.drop_plate", "fault.knock_plate")
 INVALID_WORLD_EXIT_CODE = 2
 """Exit code for a world file that does not validate; the reason is the last line on stderr."""
 
@@ -99,6 +101,7 @@ class SimNode:
         self.node.declare_parameter("fault.occlude_marker", "")
         self.node.declare_parameter("fault.remove_plate", "")
         self.node.declare_parameter("fault.drop_plate", "")
+        self.node.declare_parameter("fault.knock_plate", "")
 
     def _on_parameters(self, parameters: list[Parameter]) -> SetParametersResult:
         for parameter in parameters:
@@ -114,7 +117,7 @@ class SimNode:
             ):
                 return SetParametersResult(successful=False, reason=f"unknown station {value!r}")
             plates = {plate.labware_id for plate in self.world.plates}
-            if name in ("fault.remove_plate", "fault.drop_plate") and value and value not in plates:
+            if name in PLATE_FAULTS and value and value not in plates:
                 return SetParametersResult(successful=False, reason=f"unknown plate {value!r}")
         for parameter in parameters:
             self._apply(parameter.name, parameter.value)
@@ -128,7 +131,7 @@ class SimNode:
         elif name == "fault.occlude_marker":
             station = str(value)
             self.sim_thread.call(lambda sim: self.occluders.set_occluded(sim, station))
-        elif name in ("fault.remove_plate", "fault.drop_plate"):
+        elif name in PLATE_FAULTS:
             self.sim_thread.run(lambda sim: self._apply_plate_fault(sim, name, str(value)))
         elif name.startswith("stations.") and name.endswith(".approach_height_m"):
             station_name = name[len("stations.") : -len(".approach_height_m")]
@@ -144,6 +147,9 @@ class SimNode:
             self.plate_faults.restore(sim)
         elif name == "fault.remove_plate":
             self.plate_faults.remove(sim, labware_id)
+        elif name == "fault.knock_plate":
+            self.plate_faults.arm_knock(sim, labware_id)
+            self.sim_thread.watch(self.plate_faults.knock_if_released)
         else:
             self.plate_faults.arm_drop(sim, labware_id)
             # Checked after every batch of steps: a wall-clock timer could miss a fast drive (seen

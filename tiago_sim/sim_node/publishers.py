@@ -2,7 +2,8 @@
 
 A wall-clock timer (executor thread) takes one snapshot of the robot's own sensors from the sim
 thread and publishes it; nothing here touches PyBullet directly. /robot_state goes out when it
-changes and at 2 Hz; /station_states likewise; the head camera only while someone subscribes.
+changes and at 2 Hz; /station_states when a nest or the robot state changes and at 2 Hz; the head
+camera only while someone subscribes.
 Lives on: the rclpy executor threads of the sim node.
 """
 
@@ -12,6 +13,7 @@ import logging
 import math
 import time
 from collections.abc import Callable
+from concurrent.futures import TimeoutError as FutureTimeout
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -33,6 +35,7 @@ log = logging.getLogger(__name__)
 CAMERA_IMAGE_TOPIC = "/head_front_camera/rgb/image_raw"
 CAMERA_INFO_TOPIC = "/head_front_camera/rgb/camera_info"
 CAMERA_FRAME = "head_camera_optical_frame"
+SNAPSHOT_WAIT_S = 0.03  # s a state tick waits for the sim thread's snapshot (ticks are 50 ms apart)
 
 
 @dataclass(frozen=True)
@@ -153,11 +156,21 @@ class StatePublishers:
 
     # -- sensors -> topics ---------------------------------------------------------------
     def _tick(self) -> None:
-        if self._pending is not None and not self._pending.done():
-            return  # the sim thread is still answering the previous request
-        if self._pending is not None and self._pending.exception() is None:
-            self._publish(self._pending.result())
-        self._pending = self.sim_thread.call(self._snapshot_with_activity)
+        """Take a snapshot and publish it in the same tick when the sim thread answers within
+        SNAPSHOT_WAIT_S (it answers between batches of steps, a few ms apart); else at a later tick.
+        Why not publish it one tick later: the sequencer checks each step's effect on a report read
+        after the step, and that wait was one tick (50 ms) longer, nine times a transfer."""
+        if self._pending is None:
+            self._pending = self.sim_thread.call(self._snapshot_with_activity)
+        try:
+            snapshot = self._pending.result(timeout=SNAPSHOT_WAIT_S)
+        except FutureTimeout:
+            return  # the sim thread is still answering: the next tick publishes it
+        except Exception:  # noqa: BLE001 - the simulation is stopping; the next tick asks again
+            self._pending = None
+            return
+        self._pending = None
+        self._publish(snapshot)
 
     def _snapshot_with_activity(self, sim: Any) -> RobotSnapshot:
         """Sensors and activity read at the same instant (on the sim thread): a state read later
@@ -184,13 +197,16 @@ class StatePublishers:
         )
         now = time.monotonic()
         slow_due = now - self._last_slow_publish >= 0.5
-        if key != self._last_robot_key or slow_due:
+        robot_news = key != self._last_robot_key
+        if robot_news or slow_due:
             self.robot_state_pub.publish(state)
             self._last_robot_key = key
         # A nest that fills or empties is news too: the sequencer checks the source nest from this
         # topic, and a GetLabware sent right after a place must not read the nest as still empty.
+        # So is a robot goal's end (the robot state changed): the sequencer then checks the nest
+        # a place released into, from a report taken after the release, without waiting 0.5 s.
         nests = tuple(snapshot.nests)
-        if nests != self._last_nests or slow_due:
+        if nests != self._last_nests or slow_due or robot_news:
             self.station_pub.publish(self.station_states(snapshot))
             if nests != self._last_nests:
                 log.info("nests at sim %.3f s: %s", snapshot.sim_time, _occupied_nests(nests))

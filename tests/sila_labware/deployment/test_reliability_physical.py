@@ -8,11 +8,14 @@ The faults come from tiago_sim.measuring.fault_injection.
   node's goal log unchanged);
 - plate slips out of the hotel mid-drive (physics drops it) -> PutLabware ends with LabwareNotPlaced,
   the inventory says "lost" (no sensor watches the floor; ground truth finds it there);
+- plate knocked out of the destination nest the moment the gripper lets go -> PutLabware ends with
+  LabwareNotPlaced (PLACE_FAILED: the nest's sensor sees no plate after the release), the
+  inventory says "lost"; before, the robot reported a delivery nobody could see;
 - marker occluded -> LabwareNotPicked: tests/sila_labware/servers/test_sila_servers.py
   (test_failed_get_is_labware_not_picked_and_inventory_stays_true).
 
 The world is the default lab plus a second plate in station_b/2, the occupied destination.
-Tests run in file order (occupied destination, drop, removal) and hand the plate on.
+Tests run in file order (occupied destination, drop, removal, knock) and hand the plate on.
 A fault ends with someone putting the plate back (the fault parameter set to empty), as in a lab.
 """
 
@@ -193,3 +196,37 @@ def test_plate_taken_away_during_get_labware_is_labware_not_picked_and_the_next_
     cell.prepare_pick(A1, PLATE)
     cell.pick(A1)
     assert cell.location(PLATE) == (True, "", 1)
+
+
+def test_plate_knocked_out_of_the_nest_after_the_release_is_labware_not_placed_and_reported_lost(
+    cell: Cell,
+) -> None:
+    """Runs after the removal test: the plate is in hotel slot 1, the robot at station_a."""
+    set_fault(cell, "fault.knock_plate", PLATE)
+    try:
+        together(
+            lambda: cell.site(B1[0]).PrepareForInput(
+                HandoverPosition=B1, InternalPosition=1, LabwareType="", LabwareUniqueID=PLATE
+            ),
+            lambda: cell.manipulator.PrepareForOutput(HandoverPosition=B1, InternalPosition=1),
+        )
+        put = cell.manipulator.PutLabware(HandoverPosition=B1, IntermediateActions=[])
+        error = expect_error("LabwareNotPlaced", put, "PLACE_FAILED")
+        assert "after release: the sensor of nest station_b/1 sees no plate" in error.message
+        assert f"plate {PLATE} knocked out of its nest after the release" in sim_log(cell)
+        assert_lost(cell, PLATE)
+        expect_error(
+            "InvalidCommandSequence",
+            lambda: finish(cell.site(B1[0]).LabwareDelivered(HandoverPosition=B1)),
+            "still sees no plate",
+        )
+    finally:
+        set_fault(cell, "fault.knock_plate", "")  # someone puts the plate back in station_a/1
+    wait_nest(cell, A1, occupied=True)
+    # station_b/1 is still prepared for input: the scheduler redoes the robot's part and completes it.
+    cell.prepare_pick(A1, PLATE)
+    cell.pick(A1)
+    finish(cell.manipulator.PrepareForOutput(HandoverPosition=B1, InternalPosition=1))
+    finish(cell.manipulator.PutLabware(HandoverPosition=B1, IntermediateActions=[]))
+    finish(cell.site(B1[0]).LabwareDelivered(HandoverPosition=B1))
+    assert cell.location(PLATE) == (False, *B1)

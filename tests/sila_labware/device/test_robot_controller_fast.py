@@ -313,6 +313,44 @@ def test_a_failed_put_that_dropped_the_plate_records_it_lost() -> None:
     assert controller.inventory.locate("P1").location == UNKNOWN
 
 
+# --- a success the sensors do not show is a failure ---
+
+
+def test_a_get_reported_done_with_the_plate_not_in_its_slot_fails_and_records_what_the_sensors_say() -> None:
+    fake = at_reader_with_plate()
+    controller = controller_on(fake)
+    controller.prepare_for_input("reader", 1, 1, "plate_96", "P1")
+    # the robot side says done, but the hotel is empty and the plate is still between the fingers
+    fake.script("get_labware", succeed(robot_after=robot_state(poi="reader_poi", held="P1")))
+    with pytest.raises(TransferFailed) as failed:
+        controller.get_labware("reader", 1, [])
+    assert failed.value.error_code == "PLATE_SLIPPED"
+    assert failed.value.message == (
+        "GetLabware failed (PLATE_SLIPPED): the robot side reported success, but the sensors put P1 "
+        "at gripper, not hotel:1"
+    )
+    assert controller.inventory.locate("P1").location == GRIPPER
+    assert controller.sequence.phase.value == "idle"
+
+
+def test_a_put_reported_done_with_an_empty_nest_fails_and_records_the_plate_lost() -> None:
+    fake = carrying_to_rack()
+    controller = controller_on(fake)
+    controller.prepare_for_output("rack", 2, 1)
+    fake.script(
+        "put_labware",
+        succeed(robot_after=robot_state(poi="rack_poi"), nests_after=(nest("reader", 1), nest("rack", 2))),
+    )
+    with pytest.raises(TransferFailed) as failed:
+        controller.put_labware("rack", 2, [])
+    assert failed.value.error_code == "PLACE_FAILED"
+    assert failed.value.message == (
+        "PutLabware failed (PLACE_FAILED): the robot side reported success, but the sensors put P1 "
+        "at nowhere a sensor sees, not station:rack:2"
+    )
+    assert controller.inventory.locate("P1").location == UNKNOWN
+
+
 # --- stop and the supervisor's abort ---
 
 

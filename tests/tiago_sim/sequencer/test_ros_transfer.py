@@ -2,7 +2,9 @@
 
 Ground truth (/check_placement) judges where the plate ends up; everything else goes through
 the same actions and topics a real robot would offer. The tests share one pair of processes
-and run in file order (the plate moves on from test to test).
+and run in file order (the plate moves on from test to test). The fault tests inject through the
+sim node's parameters mid-task (waiting for the phase in the task's feedback) and end with the
+plate put back in station_a:1, where the next test expects it.
 """
 
 from __future__ import annotations
@@ -201,6 +203,120 @@ def test_plate_goes_a_to_hotel_to_b_and_back(robot: RosCaller) -> None:
         assert check.location == expected_location, check
         if kind is PutLabware:
             assert check.in_nest, f"not within clearance: {check.position_error_m * 1000:.1f} mm"
+
+
+def set_sequencer_parameter(robot: RosCaller, name: str, value: float) -> None:
+    request = parameter_request(name, value)
+    response = robot.call_service(SetParameters, "/labware_sequencer/set_parameters", request)
+    assert response.results[0].successful, response.results[0].reason
+
+
+def wait_for_phase(robot: RosCaller, handle: object, phase: str) -> None:
+    """Spin until the running task reports `phase` (a step's phase, possibly with its detail)."""
+    ended = handle.get_result_async()
+    robot.wait_for(
+        lambda: ended.done() or any(f.phase.startswith(phase) for f in handle.outcome.feedback),
+        TASK_TIMEOUT_S,
+        f"the {phase!r} phase",
+    )
+    assert not ended.done(), f"the task ended before {phase!r}: {ended.result().result.message}"
+
+
+def put_the_plate_back(robot: RosCaller, fault: str) -> None:
+    """Someone puts the faulted plate back in station_a:1 (the fault parameter set to empty)."""
+    set_parameter(robot, fault, "")
+    robot.wait_for(lambda: placement(robot, "station_a", 1).in_nest, 30.0, "the plate back in station_a:1")
+
+
+def assert_arm_out_and_empty(robot: RosCaller, outcome: object) -> None:
+    """After the failure the gripper holds nothing and the arm backed out and tucked."""
+    robot.spin_for(0.5)
+    assert robot.latest["/robot_state"].held_labware_id == ""
+    phases = [f.phase for f in outcome.feedback]
+    assert "releasing after the failure" in phases and phases[-1].startswith("arm tucked"), phases[-5:]
+
+
+def test_a_step_past_step_timeout_s_is_cancelled_and_the_task_aborts_naming_it(robot: RosCaller) -> None:
+    """No step finishes in 50 ms: the first one (the final approach) is cancelled and named."""
+    set_sequencer_parameter(robot, "step_timeout_s", 0.05)
+    try:
+        goal = task_goal(GetLabware, "station_a", 1, 1)
+        outcome = robot.call_action(GetLabware, "/get_labware", goal, timeout_s=TASK_TIMEOUT_S)
+    finally:
+        set_sequencer_parameter(robot, "step_timeout_s", 300.0)
+    assert outcome.status == GoalStatus.STATUS_ABORTED
+    assert outcome.result.error_code == ErrorCodes.MOTION_FAILED, outcome.result.message
+    assert "step 1 of" in outcome.result.message and "final approach" in outcome.result.message
+    assert "timed out after 0.05 s: cancelled" in outcome.result.message
+    assert placement(robot, "station_a", 1).in_nest, "the plate was not touched"
+
+
+def test_a_plate_taken_out_of_the_gripper_after_the_grasp_is_plate_slipped(robot: RosCaller) -> None:
+    handle = robot.send(GetLabware, "/get_labware", task_goal(GetLabware, "station_a", 1, 1))
+    assert handle.accepted
+    wait_for_phase(robot, handle, "lifting")
+    set_parameter(robot, "fault.remove_plate", PLATE)
+    try:
+        outcome = robot.result(handle, TASK_TIMEOUT_S)
+        assert outcome.status == GoalStatus.STATUS_ABORTED
+        assert outcome.result.error_code == ErrorCodes.PLATE_SLIPPED, outcome.result.message
+        assert "the gripper holds nothing" in outcome.result.message
+        assert placement(robot).location == "floor"
+        assert_arm_out_and_empty(robot, outcome)
+    finally:
+        put_the_plate_back(robot, "fault.remove_plate")
+
+
+def test_a_plate_taken_out_of_the_hotel_after_stowing_is_plate_slipped(robot: RosCaller) -> None:
+    handle = robot.send(GetLabware, "/get_labware", task_goal(GetLabware, "station_a", 1, 1))
+    assert handle.accepted
+    wait_for_phase(robot, handle, "retract")  # the plate was released into hotel slot 1
+    set_parameter(robot, "fault.remove_plate", PLATE)
+    try:
+        outcome = robot.result(handle, TASK_TIMEOUT_S)
+        assert outcome.status == GoalStatus.STATUS_ABORTED
+        assert outcome.result.error_code == ErrorCodes.PLATE_SLIPPED, outcome.result.message
+        assert "the sensor of hotel slot 1 sees no plate" in outcome.result.message
+        assert [slot.labware_id for slot in robot.latest["/robot_state"].hotel] == ["", ""]
+    finally:
+        put_the_plate_back(robot, "fault.remove_plate")
+
+
+def test_a_plate_dropped_on_the_way_to_the_nest_is_plate_slipped(robot: RosCaller) -> None:
+    outcome = robot.call_action(
+        GetLabware, "/get_labware", task_goal(GetLabware, "station_a", 1, 1), timeout_s=TASK_TIMEOUT_S
+    )
+    assert outcome.result.success, outcome.result.message
+    handle = robot.send(PutLabware, "/put_labware", task_goal(PutLabware, "station_a", 2, 1))
+    assert handle.accepted
+    wait_for_phase(robot, handle, "approach")  # carrying the plate from the hotel to the nest
+    set_parameter(robot, "fault.remove_plate", PLATE)
+    try:
+        outcome = robot.result(handle, TASK_TIMEOUT_S)
+        assert outcome.status == GoalStatus.STATUS_ABORTED
+        assert outcome.result.error_code == ErrorCodes.PLATE_SLIPPED, outcome.result.message
+        assert "after placing: the gripper holds nothing" in outcome.result.message
+        assert_arm_out_and_empty(robot, outcome)
+    finally:
+        put_the_plate_back(robot, "fault.remove_plate")
+
+
+def test_a_plate_knocked_out_of_the_nest_after_the_release_is_place_failed(robot: RosCaller) -> None:
+    outcome = robot.call_action(
+        GetLabware, "/get_labware", task_goal(GetLabware, "station_a", 1, 1), timeout_s=TASK_TIMEOUT_S
+    )
+    assert outcome.result.success, outcome.result.message
+    set_parameter(robot, "fault.knock_plate", PLATE)
+    try:
+        goal = task_goal(PutLabware, "station_a", 2, 1)
+        outcome = robot.call_action(PutLabware, "/put_labware", goal, timeout_s=TASK_TIMEOUT_S)
+        assert outcome.status == GoalStatus.STATUS_ABORTED
+        assert outcome.result.error_code == ErrorCodes.PLACE_FAILED, outcome.result.message
+        assert "after release: the sensor of nest station_a/2 sees no plate" in outcome.result.message
+        assert placement(robot).location == "floor"
+        assert_arm_out_and_empty(robot, outcome)
+    finally:
+        put_the_plate_back(robot, "fault.knock_plate")
 
 
 def test_second_motion_while_busy_is_refused_and_cancel_stops_safely(robot: RosCaller) -> None:

@@ -1,0 +1,122 @@
+"""The plans' post-conditions and the retreat after a failure, without ROS processes (milliseconds).
+
+Beside the real-process tests (test_ros_transfer.py, test_sequencer_bounds.py), which inject each
+fault into the running simulation: these pin which step checks which sensor with which error,
+what the error says the sensor saw, and how the arm backs out afterwards.
+"""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import pytest
+from labware_interfaces.msg import ErrorCodes, HotelSlot, NestState, RobotState, StationStates
+
+from labware_model.holders import GRIPPER, Nest
+from labware_model.holders import HotelSlot as Slot
+from labware_model.workcell import StationDescription, WorkcellDescription
+from tiago_sim.sequencer.plans import Expect, get_plan, put_plan, retreat_steps
+from tiago_sim.sequencer.postconditions import topic_of, unmet
+
+WORKCELL = WorkcellDescription((StationDescription("station_a", 2, "station_a_work"),), 2, (), "dock")
+A1 = Nest("station_a", 1)
+
+
+def robot(hotel: dict[int, str] | None = None, held: str = "", poi: str = "station_a_work") -> RobotState:
+    slots = [HotelSlot(index=i, labware_id=plate) for i, plate in (hotel or {1: "", 2: ""}).items()]
+    return RobotState(state="idle", current_poi=poi, hotel=slots, held_labware_id=held)
+
+
+def stations(plate: str = "", occupied: bool | None = None) -> StationStates:
+    full = bool(plate) if occupied is None else occupied
+    return StationStates(
+        nests=[
+            NestState(station="station_a", sub_position=1, occupied=full, labware_id=plate),
+            NestState(station="station_a", sub_position=2, occupied=False, labware_id=""),
+        ]
+    )
+
+
+def goal() -> SimpleNamespace:
+    return SimpleNamespace(handover_position="station_a", sub_position=1, internal_position=1)
+
+
+def checks(plan: list) -> list[tuple[str, object, str]]:
+    return [(step.phase, step.post.holder, step.post.code) for step in plan if step.post is not None]
+
+
+def test_get_checks_the_gripper_while_carrying_and_the_hotel_slot_after_stowing() -> None:
+    plan = get_plan(goal(), WORKCELL, robot(), stations("P1"), "right")
+    assert [step.phase for step in plan if step.expect_holding] == ["grasp"]
+    assert checks(plan) == [
+        ("lifting", GRIPPER, ErrorCodes.PLATE_SLIPPED),
+        ("into hotel", GRIPPER, ErrorCodes.PLATE_SLIPPED),
+        ("release", Slot(1), ErrorCodes.PLACE_FAILED),
+        ("arm tucked", Slot(1), ErrorCodes.PLATE_SLIPPED),
+    ]
+    assert plan[-1].phase == "arm tucked", "the last check is on the task's last step"
+
+
+def test_put_checks_the_hotel_before_the_grasp_and_the_nest_after_the_release() -> None:
+    plan = put_plan(goal(), WORKCELL, robot({1: "P1", 2: ""}), stations(), "right")
+    assert checks(plan) == [
+        ("final approach", Slot(1), ErrorCodes.PLATE_SLIPPED),
+        ("lifting", GRIPPER, ErrorCodes.PLATE_SLIPPED),
+        ("placing", GRIPPER, ErrorCodes.PLATE_SLIPPED),
+        ("release", A1, ErrorCodes.PLACE_FAILED),
+        ("arm tucked", A1, ErrorCodes.PLACE_FAILED),
+    ]
+
+
+@pytest.mark.parametrize(
+    ("expect", "robot_state", "station_states", "seen"),
+    [
+        (Expect(GRIPPER, "X"), robot(held="P1"), stations(), ""),
+        (Expect(GRIPPER, "X"), robot(), stations(), "the gripper holds nothing"),
+        (Expect(GRIPPER, "X"), robot(held="P7"), stations(), "the gripper holds P7, not P1"),
+        (Expect(Slot(1), "X"), robot({1: "P1", 2: ""}), stations(), ""),
+        (
+            Expect(Slot(1), "X"),
+            robot({1: "", 2: "P1"}),
+            stations(),
+            "the sensor of hotel slot 1 sees no plate",
+        ),
+        (Expect(A1, "X"), robot(), stations("P1"), ""),
+        (Expect(A1, "X"), robot(), stations("", occupied=True), ""),  # a sensor that reads no ids
+        (Expect(A1, "X"), robot(), stations(), "the sensor of nest station_a/1 sees no plate"),
+        (Expect(A1, "X"), robot(), stations("P7"), "the sensor of nest station_a/1 sees P7, not P1"),
+    ],
+)
+def test_a_post_condition_says_what_the_sensor_saw(
+    expect: Expect, robot_state: RobotState, station_states: StationStates, seen: str
+) -> None:
+    assert unmet(expect, "P1", robot_state, station_states) == seen
+
+
+def test_nest_checks_read_the_station_topic_and_the_others_the_robots() -> None:
+    assert [topic_of(Expect(holder, "X")) for holder in (GRIPPER, Slot(1), A1)] == [
+        "robot",
+        "robot",
+        "stations",
+    ]
+
+
+def retreat_after(plan: list, phase: str) -> list[tuple[str, str]]:
+    index = next(i for i, step in enumerate(plan) if step.phase == phase)
+    return [
+        (step.action, step.goal.get("motion_name") or step.goal.get("target") or step.goal.get("command"))
+        for step in retreat_steps(plan, index)
+    ]
+
+
+def test_the_arm_backs_out_of_the_nest_or_pocket_it_stands_in_and_tucks() -> None:
+    get = get_plan(goal(), WORKCELL, robot(), stations("P1"), "right")
+    put = put_plan(goal(), WORKCELL, robot({1: "P1", 2: ""}), stations(), "right")
+    open_, tuck = ("gripper", "open"), ("play_motion", "Tuck")
+    assert retreat_after(get, "grasp") == [open_, ("marker_motion", "site_approach"), tuck]
+    assert retreat_after(get, "lifting") == [open_, tuck]  # already above the nest
+    assert retreat_after(get, "into hotel") == [open_, ("play_motion", "NestApproach"), tuck]
+    assert retreat_after(get, "arm tucked") == []
+    assert retreat_after(put, "final approach") == []  # the arm has not moved yet
+    assert retreat_after(put, "grasp") == [open_, ("play_motion", "NestApproach"), tuck]
+    assert retreat_after(put, "release") == [open_, ("marker_motion", "site_approach"), tuck]

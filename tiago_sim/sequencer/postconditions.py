@@ -1,0 +1,42 @@
+"""Whether a step's post-condition holds, read from the robot's and the stations' sensors.
+
+Why: a robot command is done when its sensors show its effect, not when its last motion ended (a
+plate dropped during a place used to get a successful PutLabware). `unmet` reads one `Expect`
+against a /robot_state and a /station_states message and says, in the words of the task's error
+message, what the sensor saw instead. Pure; safe on any thread.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from labware_model.holders import Gripper, HotelSlot, Nest
+from tiago_sim.sequencer.plans import Expect, hotel_slot_state, nest_state
+
+
+def topic_of(expect: Expect) -> str:
+    """Which state topic holds the sensor: "robot" (/robot_state) or "stations" (/station_states)."""
+    return "stations" if isinstance(expect.holder, Nest) else "robot"
+
+
+def unmet(expect: Expect, labware_id: str, robot_state: Any, station_states: Any) -> str:
+    """ "" when the sensor of `expect.holder` shows the plate `labware_id` (any plate when the id is
+    unknown, or when a nest sensor cannot read ids); otherwise what it shows instead."""
+    holder = expect.holder
+    if isinstance(holder, Gripper):
+        return _compare("the gripper", "holds", robot_state.held_labware_id, labware_id)
+    if isinstance(holder, HotelSlot):
+        slot = hotel_slot_state(robot_state, holder)
+        return _compare(f"the sensor of {holder}", "sees", slot.labware_id if slot else "", labware_id)
+    reading = nest_state(station_states, holder)
+    if reading is None or not reading.occupied:
+        return f"the sensor of nest {holder} sees no plate"
+    return _compare(f"the sensor of nest {holder}", "sees", reading.labware_id or labware_id, labware_id)
+
+
+def _compare(sensor: str, verb: str, seen: str, wanted: str) -> str:
+    if not seen:
+        return f"{sensor} {verb} no plate" if verb == "sees" else f"{sensor} {verb} nothing"
+    if wanted and seen != wanted:
+        return f"{sensor} {verb} {seen}, not {wanted}"
+    return ""
