@@ -56,6 +56,7 @@ def test_a_result_is_kept_for_the_lifetime_then_forgotten(stack: Deployment) -> 
 
 
 @pytest.mark.soak
+@pytest.mark.timeout(1500)
 def test_threads_stay_flat_past_the_lifetime_while_results_expire(stack: Deployment) -> None:
     """A run longer than the lifetime: 2 finished commands a second for the lifetime plus 90 s.
     The kept results grow for the lifetime, then level off as the oldest are forgotten; the
