@@ -20,6 +20,7 @@ from sila.framework import CommandExecutionInfo, DefinedExecutionError
 from labware_model.holders import Nest
 from sila_labware.deployment.stack import Deployment, ServedServer
 from tests.helpers.sila_stack import start_stack
+from tests.helpers.transfer_steps import finish
 
 PLATE = "plate_001"
 SOURCE, DESTINATION = ("station_a", 1), ("station_b", 1)
@@ -193,19 +194,50 @@ def test_unitelabs_client_moves_the_plate_from_a_to_b(stack: Deployment) -> None
     assert nests[Nest(*DESTINATION)] and not nests[Nest(*SOURCE)]
 
 
-def test_sila2_discovery_without_a_ca_file_trusts_the_announced_ca(stack: Deployment) -> None:
-    """SiLA 2 Part B: a client given no root certificate takes the CA from the discovery record
-    and accepts the server because its certificate's common name is SiLA2."""
+def test_sila2_discovery_by_name_without_a_ca_file_runs_a_transfer(stack: Deployment) -> None:
+    """SiLA 2 Part B: a client given no root certificate takes the CA from the discovery record and
+    accepts the servers because their certificates' common name is SiLA2. Found by name alone, the
+    robot and both stations move the plate back from B to A, in the standard's order."""
     from sila2.client import SilaClient
 
-    served = stack.robot_server()
-    client = SilaClient.discover(server_uuid=served.server.server_uuid, timeout=20)
+    clients = {
+        role: SilaClient.discover(server_name=served.name, timeout=20)
+        for role, served in (
+            ("robot", stack.robot_server()),
+            ("a", stack.station_server(SOURCE[0])),
+            ("b", stack.station_server(DESTINATION[0])),
+        )
+    }
     try:
-        assert client.SiLAService.ServerUUID.get() == str(served.server.server_uuid)
-        positions = client.LabwareTransferManipulatorController.AvailableHandoverPositions.get()
-        assert {position.Position for position in positions} == {"station_a", "station_b"}
+        robot = clients["robot"].LabwareTransferManipulatorController
+        site_a, site_b = (clients[key].LabwareTransferSiteController for key in ("a", "b"))
+        assert clients["robot"].SiLAService.ServerUUID.get() == str(stack.robot_server().server.server_uuid)
+        pick, place = handover(DESTINATION), handover(SOURCE)  # the plate is in B after the test above
+        for step in (
+            [
+                lambda: site_b.PrepareForOutput(HandoverPosition=pick, InternalPosition=1),
+                lambda: robot.PrepareForInput(
+                    HandoverPosition=pick, InternalPosition=1, LabwareType="", LabwareUniqueID=PLATE
+                ),
+            ],
+            [lambda: robot.GetLabware(HandoverPosition=pick, IntermediateActions=[])],
+            [lambda: site_b.LabwareRemoved(HandoverPosition=pick)],
+            [
+                lambda: site_a.PrepareForInput(
+                    HandoverPosition=place, InternalPosition=1, LabwareType="", LabwareUniqueID=PLATE
+                ),
+                lambda: robot.PrepareForOutput(HandoverPosition=place, InternalPosition=1),
+            ],
+            [lambda: robot.PutLabware(HandoverPosition=place, IntermediateActions=[])],
+            [lambda: site_a.LabwareDelivered(HandoverPosition=place)],
+        ):
+            for instance in [start() for start in step]:
+                finish(instance)
+        assert stack.link is not None
+        assert stack.link.check_placement(PLATE, Nest(*SOURCE)).in_nest
     finally:
-        client._channel.close()  # sila2 0.14 offers no public close
+        for client in clients.values():
+            client._channel.close()  # sila2 0.14 offers no public close
 
 
 def test_two_labs_on_one_network_are_told_apart_by_name(
