@@ -282,12 +282,20 @@ class ActionGoal:
             if not self._acceptance_known.is_set():
                 self._accepted = accepted
                 self._acceptance_known.set()
-            if outcome is not None and outcome.success:
+            listeners: list[Callable[[GoalProgress], None]] = []
+            if outcome is not None and outcome.success:  # done is 100 %: the listeners hear it too
                 self._progress = GoalProgress(
                     self._fraction.advance(1.0), "done", 0.0, self._progress.feedback_count
                 )
+                listeners = list(self._progress_listeners)
+            final_progress = self._progress
             callbacks, self._callbacks = self._callbacks, []
             self._finished.set()
+        for listener in listeners:
+            try:
+                listener(final_progress)
+            except Exception:  # noqa: BLE001 - a broken listener must not stop the finishing thread
+                logger.exception("%s: progress listener failed", self.action_name)
         for callback in callbacks:
             self._run_callback(callback)
         return True

@@ -111,7 +111,7 @@ class ActionStatus(DeviceStatus):
     # --- ROS thread ---
 
     def _on_progress(self, progress: GoalProgress) -> None:
-        if self.done:
+        if self.done or self.goal.done:  # the end is reported once, when the status settles
             return
         for watcher in list(self._watchers):
             try:

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 from ros_bridge.errors import BridgeError, BridgeTimeout
 from ros_bridge.goal_status import ActionGoal, ActionOutcome
+from ros_bridge.progress import CommandProgress
 from ros_bridge.workcell import RobotStatus
 from sila_labware.device.cancellation import CancelToken, current_token
 from sila_labware.device.robot_backend import RobotBackend
@@ -93,10 +94,16 @@ class GoalRunner:
             logger.warning("%s: no end within %.0f s of the cancel", goal.action_name, self.waits.cancel_s)
         self.await_state(lambda status: status.at_rest, "the robot at rest")
 
-    def await_state(self, shows: Callable[[RobotStatus], bool], what: str) -> None:
+    def await_state(
+        self, shows: Callable[[RobotStatus], bool], what: str, progress: CommandProgress | None = None
+    ) -> None:
         """After a base motion succeeded, wait until /robot_state shows its effect, so that the
         command ends with the state properties (and the next command's checks) already true: the
-        state topic lags action results."""
+        state topic lags action results. The command's `progress` then says what remains: at most
+        this wait (a client counts a remaining time down, and the goal's last estimate has run
+        out)."""
+        if progress is not None:
+            progress.report(progress.fraction, self.waits.state_report_s)
         try:
             self._link.wait_for_robot_status(shows, self.waits.state_report_s)
         except BridgeTimeout:

@@ -191,12 +191,12 @@ class RobotController:
     def dock(self, report: ProgressReport | None = None) -> None:
         progress = CommandProgress(report, self.pace.to_wall_s)
         self._motion("Dock", lambda: self.link.dock(progress.step(0.0, 1.0)))
-        self.goals.await_state(lambda status: status.docked, "docked")
+        self.goals.await_state(lambda status: status.docked, "docked", progress)
 
     def undock(self, report: ProgressReport | None = None) -> None:
         progress = CommandProgress(report, self.pace.to_wall_s)
         self._motion("Undock", lambda: self.link.undock(progress.step(0.0, 1.0)))
-        self.goals.await_state(lambda status: status.state == RobotStatus.IDLE, "idle off the dock")
+        self.goals.await_state(lambda status: status.state == RobotStatus.IDLE, "idle off the dock", progress)
 
     def drive_to_poi(self, poi: str, report: ProgressReport | None = None) -> None:
         self.parameters.point_of_interest(poi)
@@ -206,7 +206,7 @@ class RobotController:
         self._motion(
             "DriveToPointOfInterest", lambda: self.link.navigate_to_poi(poi, progress.step(0.0, 1.0))
         )
-        self._await_arrival_report(poi)
+        self._await_arrival_report(poi, progress)
 
     def stop_motion(self) -> bool:
         """Cancel whatever goal runs; returns once the robot stands (see GoalRunner.stop)."""
@@ -234,9 +234,11 @@ class RobotController:
         finally:
             self.sequence.finish_motion()
 
-    def _await_arrival_report(self, poi: str) -> None:
+    def _await_arrival_report(self, poi: str, progress: CommandProgress) -> None:
         self.goals.await_state(
-            lambda status: status.current_poi == poi and status.state == RobotStatus.IDLE, f"idle at {poi}"
+            lambda status: status.current_poi == poi and status.state == RobotStatus.IDLE,
+            f"idle at {poi}",
+            progress,
         )
 
     def _drive_for_transfer(self, handover: Nest, progress: CommandProgress) -> None:
@@ -263,7 +265,7 @@ class RobotController:
                     raise MotionFailed(
                         outcome.error_code, _describe_failure(f"driving to {station.poi}", outcome)
                     )
-                self._await_arrival_report(station.poi)
+                self._await_arrival_report(station.poi, progress)
             progress.finish()
             success = True
         finally:

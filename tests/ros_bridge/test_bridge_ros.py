@@ -46,8 +46,9 @@ def test_goal_crosses_processes_with_feedback_and_result(echo_server, runtime: R
     assert len(seen) >= 5, "expected feedback at 20 Hz for 1 s"
     progresses = [item.progress for item in seen]
     assert progresses == sorted(progresses) and 0.0 <= progresses[0] < 0.5
-    assert all(item.phase == "driving" for item in seen)
-    assert seen[0].remaining_time_s > seen[-1].remaining_time_s
+    assert all(item.phase == "driving" for item in seen[:-1]), "feedback, then the end"
+    assert (seen[-1].progress, seen[-1].phase, seen[-1].remaining_time_s) == (1.0, "done", 0.0)
+    assert seen[0].remaining_time_s > seen[-2].remaining_time_s
     assert goal.progress.progress == 1.0 and goal.progress.phase == "done"
     assert listener_threads == {"ros-bridge_test_client"}, "feedback must arrive on the ROS thread"
     assert goal.done and goal.success and goal.exception() is None

@@ -397,9 +397,22 @@ def test_progress_rises_through_undock_and_drive_and_ends_at_one() -> None:
         "reader", 1, 1, "plate_96", "P1", report=lambda *report: reports.append(report)
     )
     assert fake.actions_sent() == ["undock", "navigate_to_poi"]
-    # undock covers 0..0.2: 0.5 -> 0.1, 1.0 -> 0.2; the drive covers 0.2..1: 0 -> 0.2, 0.25 -> 0.4,
-    # 0.1 is below the drive's 0.25 (the goal keeps 0.25 -> 0.4), 0.75 -> 0.8; the end reports 1.
-    assert [round(fraction, 9) for fraction, _ in reports] == [0.1, 0.2, 0.2, 0.4, 0.4, 0.8, 1.0]
+    # undock covers 0..0.2: 0.5 -> 0.1, 1.0 -> 0.2, its success 0.2; the drive covers 0.2..1:
+    # 0 -> 0.2, 0.25 -> 0.4, 0.1 is below the drive's 0.25 (the goal keeps 0.25 -> 0.4), 0.75 -> 0.8,
+    # its success 1.0; then the wait for the state report (1.0, with that wait's bound left); the
+    # end reports 1 with nothing left.
+    assert [round(fraction, 9) for fraction, _ in reports] == [
+        0.1,
+        0.2,
+        0.2,
+        0.2,
+        0.4,
+        0.4,
+        0.8,
+        1.0,
+        1.0,
+        1.0,
+    ]
     assert reports[-1] == (1.0, 0.0)
 
 
