@@ -31,7 +31,7 @@ log = logging.getLogger(__name__)
 TOOL_SPEED_INTO_POCKET = 0.08
 # 0.15 once "lost the plate" (SLOT_EMPTY): that was the hotel tray hitting the table, see base_alignment
 TOOL_SPEED_FREE = 0.35
-CREEP_HEIGHT = 0.018  # m above a pocket where the slow creep starts (rims: nest 7.5 mm, hotel 10 mm)
+CREEP_HEIGHT = 0.018  # m above a pocket where the slow creep starts (rims: nest 6 mm, hotel 8 mm)
 
 # Half-turn about the grasp x axis: the same top-down grasp with the fingers swapped.
 FLIP_ABOUT_APPROACH = make_transform(rotation=np.diag([1.0, -1.0, -1.0]))
