@@ -8,7 +8,10 @@ One trial = a fresh deployment (sim node built from the trial seed's disturbed w
 bridge, SiLA servers), the demo transfer, then stop. A fresh start costs about 7 s against about
 17 s for the transfer (measured on 2 cores) and guarantees independent trials; resetting a running
 world in place would save that but has to put back every plate, joint and odometry state. Trial
-k of a campaign with seed S uses disturbance seed S + k, so `--replay S+k` repeats it alone.
+k of a campaign with seed S uses disturbance seed S + k, so `--replay S+k` runs it again alone: with
+the same disturbances, not as the same run (the robot side's clock also runs, at 1x wall time,
+while the robot software computes, so a replay's timing and contacts can differ; a failure that
+does not come back on replay is not thereby explained).
 Disturbance levels are sent to the sim node as JSON in SI units (tiago_sim.measuring.disturbances reads
 them); here they are flags in mm, degrees and percent.
 
@@ -76,6 +79,16 @@ LEVEL_FLAGS = (
     LevelFlag("--camera-noise", "camera_noise", 1.0, 2.0, "head camera read noise, 8-bit grey levels"),
     LevelFlag("--plate-mass-pct", "plate_mass_spread", 1e-2, 10.0, "plate mass spread"),
     LevelFlag("--plate-friction-pct", "plate_friction_spread", 1e-2, 15.0, "plate friction spread"),
+    LevelFlag("--depth-noise-mm", "depth_noise_m", 1e-3, 1.9, "depth noise per pixel at 1 m (~z^2)"),
+    LevelFlag("--depth-bias-mm", "depth_bias_m", 1e-3, 1.0, "depth bias per trial at 1 m (~z^2)"),
+    LevelFlag("--camera-mount-mm", "camera_mount_xyz_m", 1e-3, 1.0, "hand-eye error of the camera, per axis"),
+    LevelFlag(
+        "--camera-mount-deg", "camera_mount_rpy_rad", math.pi / 180, 0.1, "hand-eye rotation error, per axis"
+    ),
+    LevelFlag(
+        "--joint-offset-deg", "joint_offset_rad", math.pi / 180, 0.1, "encoder zero error per arm/head joint"
+    ),
+    LevelFlag("--id-read-failure-pct", "id_read_failure", 1e-2, 0.1, "chance that a barcode read fails"),
 )
 
 
@@ -212,7 +225,7 @@ def run_campaign(
             break
         if not outcome.success:
             logger.warning(
-                "trial seed %d failed (%s): %s; replay: sila-labware bench --replay %d",
+                "trial seed %d failed (%s): %s; same disturbances again: sila-labware bench --replay %d",
                 trial_seed, outcome.cause, outcome.error, trial_seed,
             )  # fmt: skip
         outcomes.append(outcome)

@@ -30,13 +30,26 @@ from sila_labware.deployment.stack import DeploymentOptions
 logger = logging.getLogger(__name__)
 
 INTERRUPTED_EXIT_CODE = 130  # the shell's code for a command ended by SIGINT
+# What a replay repeats, said wherever one is offered or run: the robot side's clock also runs while
+# the robot software computes (at the idle robot's pace, 1x wall time), so when a motion starts in
+# simulated time, and with it every later contact, depends on the machine's load.
+REPLAY_REPEATS = (
+    "the same disturbances (every drawn error and noise seed), not the same run: simulated time "
+    "also passes while the robot software computes, at wall-clock pace, so the trace can differ"
+)
 
 
 def add_bench_arguments(bench: argparse.ArgumentParser) -> None:
     """Campaign options and one flag per disturbance level (defaults: the documented default level)."""
     bench.add_argument("--trials", type=int, default=30, help="number of transfers (default: %(default)s)")
     bench.add_argument("--seed", type=int, default=1, help="trial k uses disturbance seed SEED+k")
-    bench.add_argument("--replay", type=int, default=None, metavar="SEED", help="run the one trial with SEED")
+    bench.add_argument(
+        "--replay",
+        type=int,
+        default=None,
+        metavar="SEED",
+        help=f"run the one trial with SEED again: {REPLAY_REPEATS}",
+    )
     bench.add_argument("--json", action="store_true", help="print one JSON object with the results")
     bench.add_argument(
         "--report", type=Path, default=None, metavar="DIR", help="write PNG charts and run pictures"
@@ -85,7 +98,10 @@ def bench_command(args: argparse.Namespace, stack: DeploymentOptions) -> int:
     first_seed, trials = (args.replay, 1) if args.replay is not None else (args.seed, args.trials)
     frames_dir = args.report / "frames" if args.report is not None else None
     options = CampaignOptions(stack, first_seed, trials, levels, record_dir=frames_dir)
-    sys.stderr.write(f"bench: {trials} trial(s) from seed {first_seed}\n")
+    if args.replay is not None:
+        sys.stderr.write(f"bench: replaying seed {first_seed}: {REPLAY_REPEATS}\n")
+    else:
+        sys.stderr.write(f"bench: {trials} trial(s) from seed {first_seed}\n")
     on_trial = None
     if args.report is not None:
         args.report.mkdir(parents=True, exist_ok=True)
@@ -107,12 +123,16 @@ def bench_command(args: argparse.Namespace, stack: DeploymentOptions) -> int:
     interrupted = len(outcomes) < trials
     if interrupted:
         summary["interrupted_after_trials"] = len(outcomes)
+    if args.replay is not None:
+        summary["replay_repeats"] = REPLAY_REPEATS
     if args.json:
         sys.stdout.write(json.dumps(summary) + "\n")
     else:
         if interrupted:
             sys.stdout.write(f"interrupted: {len(outcomes)} of {trials} trial(s) done\n")
         sys.stdout.write(format_table(summary) + "\n\n" + format_targets(summary) + "\n")
+        if args.replay is not None:
+            sys.stdout.write(f"replayed: {REPLAY_REPEATS}\n")
     if interrupted:
         return INTERRUPTED_EXIT_CODE
     return 0 if summary["successes"] == summary["trials"] else 1

@@ -11,7 +11,17 @@ robot's calibrated site-in-marker transform is wrong by exactly the marker error
 world (what the robot's behaviours read: POIs, marker ids, site-in-marker) is the nominal one,
 except that every station POI is shifted: the base stops off the pose the station expects, as
 it does after a real navigation with localisation error. Odometry drift (wheel radius error plus
-per-step slip), Gaussian camera noise and plate mass/friction spread act inside the Simulation.
+per-step slip), camera noise (colour and depth, camera_noise), plate mass/friction spread, the
+robot's calibration errors and failing identity reads act inside the Simulation.
+
+Calibration (the true robot differs from the model the robot software keeps, the URDF both load):
+the head camera sits on the head off its modelled mount (hand-eye error: a rigid offset of the
+optical frame, drawn per axis), and every arm and head joint's encoder zero is off by a constant
+(its reading is the true angle plus the offset). Both are applied on the simulation side
+(``Simulation.T_camera_mount_error``, ``RobotBody.encoder_offsets``), so FK from joint readings
+and the nominal camera frame, as the robot software computes it, is off by what they imply.
+The torso lift's zero is not disturbed: it moves camera and arms together, so it cancels in
+every marker-relative move.
 
 Levels are standard deviations (SI: m, rad; camera noise in 8-bit grey levels; spreads relative);
 every draw is clipped at 3 sigma so a rare draw stays a physically plausible one.
@@ -24,7 +34,6 @@ import dataclasses
 import json
 import logging
 import math
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -32,10 +41,19 @@ import numpy as np
 
 from tiago_sim import transforms as tf
 from tiago_sim.lab.world import Pose2D, Station, World
+from tiago_sim.measuring.camera_noise import noisy_camera
+from tiago_sim.robot import robot_model
 
 log = logging.getLogger(__name__)
 
 CLIP_SIGMAS = 3.0
+# Joints whose encoder zero is off (the torso lift is not: see the module docstring).
+CALIBRATED_JOINTS = (
+    *robot_model.arm_joint_names("right"),
+    *robot_model.arm_joint_names("left"),
+    "head_1_joint",
+    "head_2_joint",
+)
 
 
 @dataclass(frozen=True)
@@ -52,6 +70,13 @@ class DisturbanceLevels:
     - nest 1 mm / 0.3 deg: nests screwed down with slotted holes (the "off by millimetres" case).
     - camera 2 grey levels: read noise of a consumer RGB-D camera in lab light.
     - plate mass 10 %, friction 15 %: filled versus empty plates, different polystyrene batches.
+    - depth noise 1.9 mm at 1 m (growing with distance, see camera_noise): a structured-light
+      RGB-D camera's axial noise as Nguyen et al. measured it on a Kinect; depth bias 1 mm at 1 m
+      per trial: what the depth calibration (and disparity quantisation) leaves.
+    - camera mount 1 mm and 0.1 deg per axis: what a careful hand-eye calibration leaves.
+    - joint offsets 0.1 deg per arm and head joint: encoder zeros after a factory calibration.
+    - identity reads 0.1 % failed: fixed-mount barcode readers on clean labels read 99.9 % or
+      better on the first try; worn or skewed labels read worse.
     """
 
     navigation_xy_m: float = 0.03
@@ -66,6 +91,12 @@ class DisturbanceLevels:
     camera_noise: float = 2.0
     plate_mass_spread: float = 0.10
     plate_friction_spread: float = 0.15
+    depth_noise_m: float = 0.0019  # per-pixel sigma at 1 m
+    depth_bias_m: float = 0.001  # per-trial bias sigma at 1 m
+    camera_mount_xyz_m: float = 0.001
+    camera_mount_rpy_rad: float = math.radians(0.1)
+    joint_offset_rad: float = math.radians(0.1)
+    id_read_failure: float = 0.001  # probability that one read of a plate's label fails
 
     def scaled(self, factor: float) -> DisturbanceLevels:
         """Every level times `factor` (0 gives an undisturbed world)."""
@@ -115,6 +146,14 @@ class TrialDisturbance:
     nest: dict[str, PlanarOffset] = field(default_factory=dict)  # nest row, in the site plane
     plate_mass_factor: dict[str, float] = field(default_factory=dict)
     plate_friction_factor: dict[str, float] = field(default_factory=dict)
+    camera_mount: tuple[float, ...] = (0.0,) * 6  # x, y, z (m), roll, pitch, yaw (rad) in the optical frame
+    joint_offsets: dict[str, float] = field(default_factory=dict)  # joint -> reading minus truth (rad)
+    depth_bias_m: float = 0.0  # at 1 m, growing with distance squared
+
+    def T_camera_mount_error(self) -> np.ndarray:
+        """The true optical frame in the modelled one."""
+        x, y, z, roll, pitch, yaw = self.camera_mount
+        return tf.from_xyz_rpy((x, y, z), (roll, pitch, yaw))
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready description in mm/deg (what a failure log shows next to the seed)."""
@@ -130,6 +169,10 @@ class TrialDisturbance:
             "nest": offsets(self.nest),
             "plate_mass_factor": {k: round(v, 3) for k, v in self.plate_mass_factor.items()},
             "plate_friction_factor": {k: round(v, 3) for k, v in self.plate_friction_factor.items()},
+            "camera_mount_mm_deg": [round(1000 * v, 2) for v in self.camera_mount[:3]]
+            + [round(math.degrees(v), 3) for v in self.camera_mount[3:]],
+            "joint_offsets_deg": {k: round(math.degrees(v), 3) for k, v in self.joint_offsets.items()},
+            "depth_bias_mm_at_1m": round(1000 * self.depth_bias_m, 2),
         }
 
 
@@ -159,7 +202,16 @@ def draw(world: World, seed: int, levels: DisturbanceLevels) -> TrialDisturbance
     for plate in world.plates:  # the keys, in the file's order
         mass[plate.labware_id] = 1.0 + _clipped_normal(rng, levels.plate_mass_spread)
         friction[plate.labware_id] = 1.0 + _clipped_normal(rng, levels.plate_friction_spread)
-    return TrialDisturbance(seed, levels, navigation, station, marker, nest, mass, friction)
+    # The calibration draws have their own stream: adding them left every earlier draw of a seed as it was.
+    calibration = np.random.default_rng([seed, 0xCA11B])
+    mount = tuple(_clipped_normal(calibration, levels.camera_mount_xyz_m) for _ in range(3)) + tuple(
+        _clipped_normal(calibration, levels.camera_mount_rpy_rad) for _ in range(3)
+    )
+    offsets = {name: _clipped_normal(calibration, levels.joint_offset_rad) for name in CALIBRATED_JOINTS}
+    depth_bias = _clipped_normal(calibration, levels.depth_bias_m)
+    return TrialDisturbance(
+        seed, levels, navigation, station, marker, nest, mass, friction, mount, offsets, depth_bias
+    )
 
 
 def _xyz_rpy(transform: np.ndarray) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
@@ -216,32 +268,27 @@ def believed_world(world: World, disturbance: TrialDisturbance) -> World:
     return dataclasses.replace(world, pois=pois)
 
 
-def noisy_camera(
-    render: Callable[..., tuple[np.ndarray, np.ndarray, Any]], sigma_levels: float, seed: int
-) -> Callable[..., tuple[np.ndarray, np.ndarray, Any]]:
-    """Wrap a head-camera render function: Gaussian read noise on the colour image (seeded)."""
-    rng = np.random.default_rng([seed, 0xCA])
-
-    def render_with_noise(*args: Any, **kwargs: Any) -> tuple[np.ndarray, np.ndarray, Any]:
-        rgb, depth, intrinsics = render(*args, **kwargs)
-        if sigma_levels > 0.0:
-            noise = rng.normal(0.0, sigma_levels, size=rgb.shape)
-            rgb = np.clip(rgb.astype(np.float32) + noise, 0, 255).astype(np.uint8)
-        return rgb, depth, intrinsics
-
-    return render_with_noise
-
-
 def apply_to_simulation(sim: Any, disturbance: TrialDisturbance) -> None:
-    """Plate mass/friction spread and camera noise on a built Simulation (sim thread)."""
+    """Plate spreads, camera noise, calibration errors and identity readers on a built Simulation
+    (sim thread)."""
     import pybullet as p  # only the sim process needs PyBullet
+
+    from tiago_sim.physics.identity_readers import IdentityReaders
 
     for labware_id, body in sim.scene.plates.items():
         mass = sim.scene.plate_types[labware_id].mass * disturbance.plate_mass_factor.get(labware_id, 1.0)
         friction = p.getDynamicsInfo(body, -1, physicsClientId=sim.client_id)[1]
         friction *= disturbance.plate_friction_factor.get(labware_id, 1.0)
         p.changeDynamics(body, -1, mass=mass, lateralFriction=friction, physicsClientId=sim.client_id)
+    levels = disturbance.levels
     sim.render_head_camera = noisy_camera(
-        sim.render_head_camera, disturbance.levels.camera_noise, disturbance.seed
+        sim.render_head_camera,
+        levels.camera_noise,
+        disturbance.seed,
+        depth_sigma_at_1m=levels.depth_noise_m,
+        depth_bias_at_1m=disturbance.depth_bias_m,
     )
+    sim.T_camera_mount_error = disturbance.T_camera_mount_error()
+    sim.robot.set_encoder_offsets(disturbance.joint_offsets)
+    sim.plate_sensing.readers = IdentityReaders(levels.id_read_failure, disturbance.seed)
     log.info("disturbances applied: %s", json.dumps(disturbance.summary()))

@@ -2,22 +2,31 @@
 
 Why: a microplate must be held by friction (16 N per finger, pads and plate at friction 1.0, as
 measured in the notes). Only after both pads touch the same plate does a fixed constraint
-"attach" it for travel; the constraint goes before the fingers open. Lives on the sim thread.
+"attach" it for travel; the constraint goes before the fingers open. The attach holds only what
+friction could: every step the plate's load is checked against the grip (grip_load), and a plate
+asked for more (too little grip force, a heavy plate, a knock) is let go of; from then on only the
+friction contacts of the still-closed fingers hold it, and it slips or falls as physics decides.
+Lives on the sim thread.
 """
 
 from __future__ import annotations
 
+import logging
+
 import pybullet as p
 
+from tiago_sim.physics.grip_load import GripLoad, GripLoadMonitor
 from tiago_sim.physics.motion import CANCELED, Motion
 from tiago_sim.physics.robot_body import RobotBody
 from tiago_sim.robot import robot_model as rm
+
+log = logging.getLogger(__name__)
 
 PAD_FRICTION = 1.0
 PAD_SPINNING_FRICTION = 0.02
 STALL_SPEED = 0.002  # m/s: fingers count as stopped below this
 STALL_TIME_S = 0.15
-ATTACH_FORCE = 60.0  # N
+ATTACH_FORCE = 60.0  # N: the constraint's own limit; the grip check (grip_load) lets go far below it
 HOLDER_FRICTION = 0.15  # the hotel's polished lead-ins, as the station nests' (see scene.NEST_FRICTION)
 GEAR_FORCE = 5.0  # N: keeps the fingers in step in free motion, yields so both pads reach an off-centre plate
 
@@ -34,6 +43,10 @@ class Gripper:
         self.palm_link, _ = body.frame_on_link(f"gripper_{side}_link")
         self.attach_constraint: int | None = None
         self.attached_id = ""
+        self.grip_force_n = rm.FINGER_EFFORT  # per finger; lower it to model a weak grip (tests)
+        self.slipped_id = ""  # a plate the attach let go of for overload, until the fingers open
+        self.last_slip: GripLoad | None = None
+        self._grip_monitor: GripLoadMonitor | None = None
         client = body.client
         for link in self.finger_links:
             p.changeDynamics(
@@ -62,7 +75,9 @@ class Gripper:
         self.command(rm.FINGER_TRAVEL)
 
     def command(self, finger_position: float) -> None:
-        self.body.command_positions({name: finger_position for name in self.fingers})
+        self.body.command_positions(
+            {name: finger_position for name in self.fingers}, force_scale=self.grip_force_n / rm.FINGER_EFFORT
+        )
 
     def opening(self) -> float:
         """Gap between the pads in m."""
@@ -85,12 +100,32 @@ class Gripper:
         plate = self.plate_bodies[labware_id]
         self.attach_constraint = self.body.fix_to_link(self.palm_link, plate, ATTACH_FORCE)
         self.attached_id = labware_id
+        self._grip_monitor = GripLoadMonitor(
+            self.body.client, self.body.id, plate, self.finger_links, self.grip_force_n
+        )
 
     def detach(self) -> None:
+        """Remove the attach (before the fingers open, or when the grip cannot hold the plate)."""
         if self.attach_constraint is not None:
             p.removeConstraint(self.attach_constraint, physicsClientId=self.body.client)
         self.attach_constraint = None
         self.attached_id = ""
+        self._grip_monitor = None
+
+    def check_grip(self, dt: float) -> GripLoad | None:
+        """After a physics step: the attached plate's load; lets go of it if friction could not hold it."""
+        if self._grip_monitor is None:
+            return None
+        load = self._grip_monitor.load(dt, self.body.link_pose(f"arm_{self.side}_grasping_frame"))
+        if not load.holds:
+            log.warning("%s gripper: %s slips: %s", self.side, self.attached_id, load.describe())
+            self.slipped_id, self.last_slip = self.attached_id, load
+            self.detach()
+        return load
+
+    def loose(self) -> bool:
+        """A plate the attach let go of is still between the pads: held by friction contacts alone."""
+        return bool(self.slipped_id) and self.touching() == self.slipped_id
 
 
 class GripperMotion(Motion):
@@ -109,6 +144,7 @@ class GripperMotion(Motion):
         self.phase = "closing" if close else "opening"
         if not close:
             gripper.detach()
+            gripper.slipped_id = ""
         gripper.command(0.0 if close else rm.FINGER_TRAVEL)
         self.remaining_s = rm.FINGER_TRAVEL / rm.FINGER_SPEED + 0.3
 

@@ -6,7 +6,13 @@ and not on anything a real pocket does. So a turning base with plates aboard had
 at the short step. Clamped, the base drives at the free-motion step whatever it carries. The
 clamp closes on plates already resting in a pocket when a base motion starts and opens once the
 base stands again, before any arm reaches in; nothing moves a plate into place, and where a plate
-is is still read from physics. Lives on the sim thread.
+is is still read from physics.
+
+The clamp stands in for the pocket only against the base's own motion (the pocket's walls and floor
+hold a plate through the base's accelerations and turns). Anything else that pushes on a clamped
+plate (a table edge the tray sweeps into, an arm) opens the clamp on it at once if the push exceeds
+what the plate's weight presses into the pocket floor's friction (about 0.5 N for a 0.35 kg plate):
+from then on its contacts alone decide whether it stays. Lives on the sim thread.
 """
 
 from __future__ import annotations
@@ -20,6 +26,7 @@ from tiago_sim.physics.robot_body import RobotBody
 log = logging.getLogger(__name__)
 
 CLAMP_FORCE = 60.0  # N, as the gripper's travel attach
+GRAVITY = 9.81
 
 
 class HotelClamp:
@@ -54,6 +61,29 @@ class HotelClamp:
             if constraint is not None:
                 p.removeConstraint(constraint, physicsClientId=self.body.client)
                 log.debug("hotel clamp opened on %s", name)
+
+    def release_pushed(self, friction: float) -> list[str]:
+        """After a physics step: open the clamp on every plate something else pushes harder than
+        ``friction`` times its weight; returns their ids."""
+        client = self.body.client
+        released = []
+        for labware_id in list(self.constraints):
+            plate = self.plate_bodies[labware_id]
+            limit = friction * GRAVITY * p.getDynamicsInfo(plate, -1, physicsClientId=client)[0]
+            push = max(
+                (
+                    point[9]
+                    for point in p.getContactPoints(bodyA=plate, physicsClientId=client)
+                    if not (point[2] == self.body.id and point[4] == -1)  # the tray itself
+                ),
+                default=0.0,
+            )
+            if push > limit:
+                log.warning("hotel clamp opens on %s: pushed with %.1f N (limit %.2f N)", labware_id, push,
+                            limit)  # fmt: skip
+                self.open(labware_id)
+                released.append(labware_id)
+        return released
 
     @property
     def closed(self) -> bool:

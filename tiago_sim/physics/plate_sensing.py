@@ -1,9 +1,10 @@
 """The plate sensors of the lab and the robot, and the physics' own judgement of a delivery.
 
 Why together: both read where plates rest from PyBullet. The presence sensors (one per nest, one
-per hotel pocket) report what a real sensor could (a plate there, and which one: see the README's
-modelling notes); ``check_placement`` is ground truth and serves success checks only, never robot
-control; whether a plate is seated, and every limit, comes from `seating`. Lives on the sim thread.
+per hotel pocket) report what a real sensor could: a plate there; which one only as far as the
+holder's identity reader read its label (identity_readers, which can fail). ``check_placement`` is
+ground truth and serves success checks only, never robot control; whether a plate is seated, and
+every limit, comes from `seating`. Lives on the sim thread.
 """
 
 from __future__ import annotations
@@ -14,10 +15,11 @@ from typing import Any
 import numpy as np
 import pybullet as p
 
-from labware_model.holders import FLOOR, GRIPPER, UNKNOWN, HotelSlot, Location, Nest
+from labware_model.holders import FLOOR, GRIPPER, UNKNOWN, HotelSlot, Location, Nest, location_text
 from labware_model.readings import HotelSlotReading, NestReading, PlacementCheck
 from tiago_sim import transforms as tf
 from tiago_sim.lab.world import World
+from tiago_sim.physics.identity_readers import IdentityReaders
 from tiago_sim.physics.robot_body import RobotBody
 from tiago_sim.physics.scene import plate_bottom_pose
 from tiago_sim.physics.seating import PoseInNest, SeatingLimits
@@ -37,6 +39,7 @@ class PlateSensing:
         self._scene = scene
         self._grippers = grippers
         self._nest_sites_cache: list[tuple[Nest, np.ndarray]] | None = None
+        self.readers = IdentityReaders()  # perfect readers unless a disturbance sets a failure rate
 
     def plate_bottom(self, labware_id: str) -> np.ndarray:
         body = self._scene.plates[labware_id]
@@ -74,22 +77,38 @@ class PlateSensing:
             ]
         return self._nest_sites_cache
 
-    def nest_readings(self) -> list[NestReading]:
+    def _nest_occupants(self) -> list[tuple[Nest, str]]:
+        """(nest, the plate physically in it or "") for every nest: ground truth."""
         bottoms = self._plate_bottom_points()
-        result = []
-        for nest, T_world_site in self._nest_sites():
-            labware_id = self._plate_near(T_world_site, bottoms)
-            result.append(NestReading(nest, bool(labware_id), labware_id))
-        return result
+        return [(nest, self._plate_near(T_world_site, bottoms)) for nest, T_world_site in self._nest_sites()]
+
+    def _hotel_occupants(self) -> list[tuple[HotelSlot, str]]:
+        """(slot, the plate physically in it or "") for every hotel pocket: ground truth."""
+        bottoms = self._plate_bottom_points()
+        return [
+            (HotelSlot(index), self._plate_near(self._robot.link_pose(f"hotel_slot_{index}"), bottoms))
+            for index in range(1, self._world.hotel_slots + 1)
+        ]
+
+    def nest_readings(self) -> list[NestReading]:
+        """Presence from physics; the id as the nest's reader read it."""
+        return [
+            NestReading(nest, bool(labware_id), self.readers.report(location_text(nest), labware_id))
+            for nest, labware_id in self._nest_occupants()
+        ]
 
     def hotel_readings(self) -> list[HotelSlotReading]:
-        bottoms = self._plate_bottom_points()
+        """The id (and the type it names) as the pocket's reader read it; "" when empty or unread."""
         result = []
-        for index in range(1, self._world.hotel_slots + 1):
-            labware_id = self._plate_near(self._robot.link_pose(f"hotel_slot_{index}"), bottoms)
+        for slot, present in self._hotel_occupants():
+            labware_id = self.readers.report(location_text(slot), present)
             labware_type = self._scene.plate_types[labware_id].name if labware_id else ""
-            result.append(HotelSlotReading(HotelSlot(index), labware_id, labware_type))
+            result.append(HotelSlotReading(slot, labware_id, labware_type))
         return result
+
+    def held_reading(self, side: str, present: str) -> str:
+        """The id the gripper's reader gives for the plate between its pads ("" if none or unread)."""
+        return self.readers.report(f"gripper_{side}", present)
 
     def check_placement(self, labware_id: str, nest: Nest | None) -> PlacementCheck:
         if labware_id not in self._scene.plates:
@@ -108,12 +127,12 @@ class PlateSensing:
         for _side, gripper in self._grippers.items():
             if gripper.attached_id == labware_id or gripper.touching() == labware_id:
                 return GRIPPER
-        for nest_reading in self.nest_readings():
-            if nest_reading.labware_id == labware_id:
-                return nest_reading.nest
-        for slot_reading in self.hotel_readings():
-            if slot_reading.labware_id == labware_id:
-                return slot_reading.slot
+        for nest, present in self._nest_occupants():
+            if present == labware_id:
+                return nest
+        for slot, present in self._hotel_occupants():
+            if present == labware_id:
+                return slot
         if self.plate_bottom(labware_id)[2, 3] < 0.05:
             return FLOOR
         return UNKNOWN

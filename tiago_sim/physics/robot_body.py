@@ -2,7 +2,13 @@
 
 Why: controllers speak URDF joint names; this is the one place that maps them to PyBullet
 indices. The base is carried by a fixed constraint whose pivot follows the commanded planar
-motion (see base_controller). Lives on the sim thread.
+motion (see base_controller).
+
+Joint readings and position commands are in encoder terms: with ``encoder_offsets`` set (a joint
+calibration error, see tiago_sim.measuring.disturbances) a joint reads its true angle plus its
+offset, and a commanded position puts the true joint at the command minus the offset, as on a
+robot whose encoder zeros are off. Everything above this class (controllers, IK, the robot
+software) sees only encoder values; link poses (rendering, physics) stay true. Lives on the sim thread.
 """
 
 from __future__ import annotations
@@ -76,7 +82,8 @@ class RobotBody:
             physicsClientId=client,
         )
         p.changeConstraint(self.base_constraint, maxForce=BASE_CONSTRAINT_FORCE, physicsClientId=client)
-        self.targets: dict[str, float] = {}
+        self.targets: dict[str, float] = {}  # commanded, in encoder terms
+        self.encoder_offsets: dict[str, float] = {}  # joint name -> reading minus true position
         self._track_groups: dict[tuple[str, ...], tuple] = {}
         self.frame_offsets = _fixed_frame_offsets()
 
@@ -130,9 +137,21 @@ class RobotBody:
         return vx * math.cos(yaw) + vy * math.sin(yaw), angular[2]
 
     def joint_positions(self) -> dict[str, float]:
+        """Encoder readings: the true positions plus ``encoder_offsets``."""
         names = list(self.joint_index)
         states = p.getJointStates(self.id, [self.joint_index[n] for n in names], physicsClientId=self.client)
-        return {name: float(state[0]) for name, state in zip(names, states, strict=True)}
+        offsets = self.encoder_offsets
+        return {n: float(state[0]) + offsets.get(n, 0.0) for n, state in zip(names, states, strict=True)}
+
+    def set_encoder_offsets(self, offsets: dict[str, float]) -> None:
+        """Joint calibration errors (rad or m); the true posture stays, its readings change."""
+        unknown = set(offsets) - set(self.joint_index)
+        if unknown:
+            raise KeyError(f"unknown joints: {sorted(unknown)}")
+        old = self.encoder_offsets
+        self.targets = {n: v - old.get(n, 0.0) + offsets.get(n, 0.0) for n, v in self.targets.items()}
+        self.encoder_offsets = dict(offsets)
+        self._track_groups.clear()
 
     def joint_velocities(self, names: list[str]) -> np.ndarray:
         states = p.getJointStates(self.id, [self.joint_index[n] for n in names], physicsClientId=self.client)
@@ -142,10 +161,12 @@ class RobotBody:
         self, targets: dict[str, float], velocities: dict[str, float] | None = None, force_scale: float = 1.0
     ) -> None:
         """Position-control the named joints within their URDF effort and velocity limits."""
-        for name, target in targets.items():
+        for name, commanded in targets.items():
             lower, upper, velocity_limit, effort = self.limits[name]
-            target = min(max(float(target), lower), upper) if upper > lower else float(target)
-            self.targets[name] = target
+            offset = self.encoder_offsets.get(name, 0.0)
+            target = float(commanded) - offset  # the true position the motor drives to
+            target = min(max(target, lower), upper) if upper > lower else target
+            self.targets[name] = target + offset
             p.setJointMotorControl2(
                 self.id,
                 self.joint_index[name],
@@ -177,11 +198,13 @@ class RobotBody:
                 [self.limits[n][3] for n in names],
                 [ARM_POSITION_GAIN] * len(names),
                 [1.0] * len(names),
+                np.array([self.encoder_offsets.get(n, 0.0) for n in names]),
             )
             self._track_groups[key] = group
-        indices, lower, upper, forces, position_gains, velocity_gains = group
-        clipped = np.minimum(np.maximum(positions, lower), upper).tolist()
-        self.targets.update(zip(names, clipped, strict=True))
+        indices, lower, upper, forces, position_gains, velocity_gains, offsets = group
+        clipped = np.minimum(np.maximum(np.asarray(positions) - offsets, lower), upper)
+        self.targets.update(zip(names, (clipped + offsets).tolist(), strict=True))
+        clipped = clipped.tolist()
         p.setJointMotorControlArray(
             self.id,
             indices,

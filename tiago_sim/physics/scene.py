@@ -11,7 +11,6 @@ sides free for the finger pads.
 from __future__ import annotations
 
 import logging
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -22,6 +21,7 @@ from labware_model.labware import LabwareType
 from tiago_sim import transforms as tf
 from tiago_sim.lab.world import Station, World
 from tiago_sim.perception.marker_asset import marker_visual
+from tiago_sim.robot.hotel_model import corner_ramp_boxes
 from tiago_sim.robot.robot_model import BASE_RADIUS
 
 log = logging.getLogger(__name__)
@@ -65,31 +65,18 @@ def nest_boxes(length: float, width: float) -> list[tuple[tuple, tuple, tuple]]:
     """Boxes (size, centre, quaternion) of a nest: four corner L-brackets of 45 deg lead-in ramps.
 
     Each bracket leg is a ramp rising from the pocket edge on the bench top to ``NEST_LEAD_IN``
-    outside it, so a plate released up to clearance + lead-in off centre slides into the pocket
-    (low-friction bracket material). The ramp starts at the bench top, with no vertical wall under
-    it: a wall's top corner is a ledge on which a plate's bottom rests 1 deg tilted, held by the
-    bench's friction under its other edge (campaigns 6000 and 7000 lost 1 to 1.5 % of transfers so).
+    outside it (hotel_model.corner_ramp_boxes, which the onboard hotel's pockets share), so a plate
+    released up to clearance + lead-in off centre slides into the pocket (low-friction bracket
+    material). The ramp starts at the bench top, with no vertical wall under it: a wall's top corner
+    is a ledge on which a plate's bottom rests 1 deg tilted, held by the bench's friction under its
+    other edge (campaigns 6000 and 7000 lost 1 to 1.5 % of transfers so).
     """
-    boxes = []
-    overlap, leg, lead, foot, thick = 0.006, NEST_LEG_LENGTH, NEST_LEAD_IN, NEST_RAMP_FOOT, 0.004
-    slope = (lead + foot) * math.sqrt(2.0)
-    inset = thick / 2 / math.sqrt(2.0)  # from the ramp surface to the box's mid-plane, along x (or y) and z
-    mid = (lead - foot) / 2  # the middle of the ramp surface, outwards of the pocket edge and above the bench
-    for cx in (-1, 1):
-        for cy in (-1, 1):
-            # leg across the short end (ramp rising along x), spanning `leg` in from the corner
-            along_y = cy * (width / 2 - leg / 2 + overlap / 2)
-            quat_x = tf.matrix_to_quat(
-                tf.rpy_to_matrix(0.0, -math.pi / 4 if cx > 0 else -3 * math.pi / 4, 0.0)
-            )
-            centre_x = (cx * (length / 2 + mid + inset), along_y, mid - inset)
-            boxes.append(((slope, leg + overlap, thick), centre_x, tuple(quat_x)))
-            # leg along the long side (ramp rising along y)
-            along_x = cx * (length / 2 - leg / 2)
-            quat_y = tf.matrix_to_quat(tf.rpy_to_matrix(math.pi / 4 if cy > 0 else 3 * math.pi / 4, 0.0, 0.0))
-            centre_y = (along_x, cy * (width / 2 + mid + inset), mid - inset)
-            boxes.append(((leg, slope, thick), centre_y, tuple(quat_y)))
-    return boxes
+    return [
+        (size, centre, tuple(tf.matrix_to_quat(tf.rpy_to_matrix(*rpy))))
+        for size, centre, rpy in corner_ramp_boxes(
+            length, width, NEST_LEAD_IN, foot=NEST_RAMP_FOOT, leg=NEST_LEG_LENGTH
+        )
+    ]
 
 
 def _compound_static(client: int, boxes, T_world_body: np.ndarray, rgba) -> int:

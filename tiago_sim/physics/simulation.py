@@ -22,7 +22,7 @@ from tiago_sim.lab.world import World
 from tiago_sim.perception.camera import CameraIntrinsics, render_rgbd
 from tiago_sim.physics.arm_controller import JointTrajectoryMotion
 from tiago_sim.physics.base_controller import DiffDriveBase, DriveMotion, docking_motion
-from tiago_sim.physics.gripper_controller import Gripper, GripperMotion
+from tiago_sim.physics.gripper_controller import HOLDER_FRICTION, Gripper, GripperMotion
 from tiago_sim.physics.hotel_clamp import HotelClamp
 from tiago_sim.physics.motion import BUSY, CompletedMotion, FailedMotion, Motion
 from tiago_sim.physics.plate_sensing import PlateSensing
@@ -116,6 +116,9 @@ class Simulation:
             for side in rm.ARM_SIDES
         }
         self.kinematics = RobotKinematics()
+        # The head camera's true mount against the model's head_camera_optical_frame (a hand-eye
+        # calibration error; identity unless tiago_sim.measuring.disturbances sets one).
+        self.T_camera_mount_error = np.eye(4)
         self.motions: list[Motion] = []
         self._iterations = SOLVER_ITERATIONS
         self._step = time_step
@@ -147,6 +150,7 @@ class Simulation:
         self.base.update(dt)
         started = time.thread_time()
         p.stepSimulation(physicsClientId=self.client_id)
+        self._check_holds(dt)
         self.step_ledger.record(dt, self._iterations, time.thread_time() - started)
         self.base.integrate_odometry(dt)
         self.sim_time += dt
@@ -163,12 +167,22 @@ class Simulation:
             self.hotel_clamp.open()
             self._clamped_for_drive = False
 
+    def _check_holds(self, dt: float) -> None:
+        """Constraints hold a plate only while friction could (gripper_controller, hotel_clamp)."""
+        for gripper in self.grippers.values():
+            gripper.check_grip(dt)
+        if self.hotel_clamp.constraints:
+            self.hotel_clamp.release_pushed(HOLDER_FRICTION)
+
     def _held_plates(self) -> set[str]:
         return {g.attached_id for g in self.grippers.values() if g.attached_id}
 
     def _choose_step(self) -> float:
         """Solver iterations and step length for the coming step (see the constants above)."""
-        grasping = any(isinstance(m, GripperMotion) for m in self.motions)
+        # a plate the attach let go of is held by friction contacts alone: those need the grasp settings
+        grasping = any(isinstance(m, GripperMotion) for m in self.motions) or any(
+            g.slipped_id and g.loose() for g in self.grippers.values()
+        )
         if not grasping and self.sim_time - self._reviewed_at >= STEP_REVIEW_PERIOD - 1e-9:
             self._reviewed_at = self.sim_time
             self._plate_within_range = self._robot_near_resting_plate() or self._held_plate_near_anything()
@@ -260,9 +274,13 @@ class Simulation:
 
     def render_head_camera(self, supersample: int = 1) -> tuple[np.ndarray, np.ndarray, CameraIntrinsics]:
         intrinsics = CameraIntrinsics()
-        T_world_optical = self.robot.link_pose("head_camera_optical_frame")
+        T_world_optical = self.true_camera_pose()
         rgb, depth = render_rgbd(self.client_id, T_world_optical, intrinsics, supersample=supersample)
         return rgb, depth, intrinsics
+
+    def true_camera_pose(self) -> np.ndarray:
+        """T_world_optical of the head camera as mounted (ground truth: rendering and checks only)."""
+        return self.robot.link_pose("head_camera_optical_frame") @ self.T_camera_mount_error
 
     def nest_readings(self) -> list[NestReading]:
         """Every nest, as its presence sensor sees it (a plate there, and which one)."""
@@ -277,9 +295,10 @@ class Simulation:
         return self.plate_sensing.plate_bottom(labware_id)
 
     def held_labware(self, arm: str) -> str:
-        """Plate between that gripper's pads (both touching), or the one attached after a verified grasp."""
+        """Plate between that gripper's pads (both touching), or the one attached after a verified grasp,
+        as the gripper's identity reader read it ("" if its read failed)."""
         gripper = self.grippers[arm]
-        return gripper.touching() or gripper.attached_id
+        return self.plate_sensing.held_reading(arm, gripper.touching() or gripper.attached_id)
 
     # ----------------------------------------------------------------- motions
     def drive_to(self, x: float, y: float, yaw: float, speed: float = rm.MAX_LINEAR_SPEED) -> Motion:

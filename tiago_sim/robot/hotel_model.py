@@ -15,56 +15,52 @@ from tiago_sim.robot.urdf_writer import UrdfWriter
 # Hotel (onboard plate holder): pocket floors on the base front, reachable top-down by either arm
 HOTEL_SLOT_XYZ = ((0.25, -0.07, 0.60), (0.25, 0.07, 0.60))
 HOTEL_POCKET_SIZE = (0.1318, 0.0895)  # inner length x width, 2 mm clearance per side
-HOTEL_WALL_HEIGHT = 0.004  # vertical part at the pocket edge; the lead-in chamfer sits on top (rim 10 mm)
-HOTEL_LEAD_IN = 0.006  # per side, 45 deg chamfers on the corner posts: a plate carried a few mm off
-# centre in the gripper slides into the pocket instead of resting on a post (seed 102 of the campaign)
+# Per side, 45 deg ramps rising from the pocket floor at the pocket edge to this far outside it (the
+# rim's height too), as the station nests' brackets. The pockets had a 4 mm vertical wall under 6 mm
+# chamfers until the default calibration errors (joint offsets, about 1.3 mm median at the hotel) put
+# plates at the pocket edge: a plate's end then came to rest on the wall's top corner, 2 deg tilted
+# (3 of 6 scripted placements, seeds 40010 to 40049), the failure mode the nests had with a 1.5 mm wall.
+HOTEL_LEAD_IN = 0.008
+RAMP_FOOT = 0.001  # a ramp runs on this far below the floor it rises from: no edge is left at its foot
+RAMP_LEG_LENGTH = 0.015  # bracket legs run this far in from each corner
+RAMP_THICKNESS = 0.004
 
 
-def corner_bracket_boxes(length: float, width: float, height: float, leg: float = 0.015, wall: float = 0.006):
-    """Boxes (size, centre) of four L-brackets framing a pocket of inner size length x width.
+def corner_ramp_boxes(
+    length: float, width: float, lead: float, foot: float = RAMP_FOOT, leg: float = RAMP_LEG_LENGTH
+) -> list[tuple[tuple[float, float, float], tuple[float, float, float], tuple[float, float, float]]]:
+    """Boxes (size, centre, rpy) of four corner L-brackets of 45 deg lead-in ramps around a pocket.
 
-    The brackets hold only the corners, so the middle of each long side stays free for finger pads.
+    The frame is the pocket floor's centre. Each bracket leg is a ramp rising from the pocket edge
+    on the floor to ``lead`` outside it, so a plate released up to clearance + lead off centre slides
+    into the pocket; with no vertical wall under the ramp there is no ledge for a plate's bottom to
+    rest on. The brackets leave the middle of the long sides free for the finger pads.
     """
     boxes = []
+    overlap, thick = 0.006, RAMP_THICKNESS
+    slope = (lead + foot) * math.sqrt(2.0)
+    inset = thick / 2 / math.sqrt(2.0)  # from the ramp surface to the box's mid-plane, along x (or y) and z
+    mid = (lead - foot) / 2  # the middle of the ramp surface, outwards of the pocket edge and above the floor
     for cx in (-1, 1):
         for cy in (-1, 1):
-            x_edge = cx * (length / 2 + wall / 2)
-            y_edge = cy * (width / 2 + wall / 2)
-            boxes.append(
-                ((wall, leg + wall, height), (x_edge, cy * (width / 2 - leg / 2 + wall / 2), height / 2))
-            )
-            boxes.append(((leg, wall, height), (cx * (length / 2 - leg / 2), y_edge, height / 2)))
+            # leg across the short end (ramp rising along x), spanning `leg` in from the corner
+            along_y = cy * (width / 2 - leg / 2 + overlap / 2)
+            pitch = -math.pi / 4 if cx > 0 else -3 * math.pi / 4
+            centre_x = (cx * (length / 2 + mid + inset), along_y, mid - inset)
+            boxes.append(((slope, leg + overlap, thick), centre_x, (0.0, pitch, 0.0)))
+            # leg along the long side (ramp rising along y)
+            along_x = cx * (length / 2 - leg / 2)
+            roll = math.pi / 4 if cy > 0 else 3 * math.pi / 4
+            centre_y = (along_x, cy * (width / 2 + mid + inset), mid - inset)
+            boxes.append(((leg, slope, thick), centre_y, (roll, 0.0, 0.0)))
     return boxes
 
 
-def _corner_brackets(x: float, y: float, z: float, length: float, width: float):
+def _pocket_ramps(x: float, y: float, z: float, length: float, width: float):
     return [
-        ("box", size, (x + cx, y + cy, z + cz), (0, 0, 0), "dark")
-        for size, (cx, cy, cz) in corner_bracket_boxes(length, width, HOTEL_WALL_HEIGHT)
-    ] + _lead_ins(x, y, z, length, width)
-
-
-def _lead_ins(
-    x: float, y: float, z: float, length: float, width: float, leg: float = 0.015, wall: float = 0.006
-):
-    """45 deg chamfer plates on top of the corner posts, widening the opening by HOTEL_LEAD_IN per side."""
-    lead, thick, top = HOTEL_LEAD_IN, 0.003, z + HOTEL_WALL_HEIGHT
-    slope = lead * math.sqrt(2.0)
-    inset = thick / 2 / math.sqrt(2.0)  # the plate's lower face meets the wall's top edge
-    shapes = []
-    for cx in (-1, 1):
-        for cy in (-1, 1):
-            across = (x + cx * (length / 2 + lead / 2 + inset), y + cy * (width / 2 - leg / 2 + wall / 2))
-            shapes.append(
-                ("box", (slope, leg + wall, thick), (*across, top + lead / 2 - inset),
-                 (0, -math.pi / 4 if cx > 0 else -3 * math.pi / 4, 0), "dark")
-            )  # fmt: skip
-            along = (x + cx * (length / 2 - leg / 2), y + cy * (width / 2 + lead / 2 + inset))
-            shapes.append(
-                ("box", (leg, slope, thick), (*along, top + lead / 2 - inset),
-                 (math.pi / 4 if cy > 0 else 3 * math.pi / 4, 0, 0), "dark")
-            )  # fmt: skip
-    return shapes
+        ("box", size, (x + cx, y + cy, z + cz), rpy, "dark")
+        for size, (cx, cy, cz), rpy in corner_ramp_boxes(length, width, HOTEL_LEAD_IN)
+    ]
 
 
 def add_hotel(w: UrdfWriter, wheel_radius: float) -> None:
@@ -76,7 +72,7 @@ def add_hotel(w: UrdfWriter, wheel_radius: float) -> None:
         shapes.append(
             ("box", (length + 0.03, width + 0.02, 0.01), (x, y, z - 0.005 - wheel_radius), (0, 0, 0), "grey")
         )
-        shapes.extend(_corner_brackets(x, y, z - wheel_radius, length, width))
+        shapes.extend(_pocket_ramps(x, y, z - wheel_radius, length, width))
     post_top = HOTEL_SLOT_XYZ[0][2] - 0.01 - wheel_radius
     base_top = 0.297 - wheel_radius
     post_height = post_top - base_top

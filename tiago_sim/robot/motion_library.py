@@ -33,11 +33,18 @@ class HotelGrasp:
     grasp_height_m: float  # grasping frame origin above the pocket floor when in "Nest"
     approach_height_m: float  # extra height above that for "NestApproach"
     carry_height_m: float = 0.15  # tool rises this far above "NestApproach" to travel to/from the hotel
+    # Grasping frame above the floor where a held plate is let go of (a nest's or a pocket's): the
+    # plate then hangs this much minus grasp_height_m above the floor and drops the rest. 0: as
+    # grasp_height_m, i.e. lowered until it would touch.
+    release_height_m: float = 0.0
 
-    def T_slot_grasp(self, approach: bool) -> np.ndarray:
-        """Grasp pose in the slot frame: x (approach) down, y (closing) across the short side."""
+    def T_slot_grasp(self, approach: bool, releasing: bool = False) -> np.ndarray:
+        """Grasp pose in the slot frame: x (approach) down, y (closing) across the short side.
+
+        ``releasing``: the pose where a held plate is let go of (``release_height_m``)."""
         rotation = np.column_stack([[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]])
-        height = self.grasp_height_m + (self.approach_height_m if approach else 0.0)
+        floor_height = max(self.release_height_m, self.grasp_height_m) if releasing else self.grasp_height_m
+        height = floor_height + (self.approach_height_m if approach else 0.0)
         return make_transform((0.0, 0.0, height), rotation)
 
 
@@ -92,6 +99,7 @@ def load_motions(path: Path = DEFAULT_MOTIONS_FILE) -> MotionLibrary:
             grasp_height_m=float(need(hotel, "grasp_height_m", "hotel.")),
             approach_height_m=float(need(hotel, "approach_height_m", "hotel.")),
             carry_height_m=float(need(hotel, "carry_height_m", "hotel.")),
+            release_height_m=float(hotel.get("release_height_m", 0.0)),
         ),
         speed_scale=float(document.get("speed_scale", 1.0)),
     )

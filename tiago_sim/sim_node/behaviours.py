@@ -31,7 +31,7 @@ log = logging.getLogger(__name__)
 TOOL_SPEED_INTO_POCKET = 0.08
 # 0.15 once "lost the plate" (SLOT_EMPTY): that was the hotel tray hitting the table, see base_alignment
 TOOL_SPEED_FREE = 0.35
-CREEP_HEIGHT = 0.018  # m above a pocket where the slow creep starts (rims: nest 7.5 mm, hotel 10 mm)
+CREEP_HEIGHT = 0.018  # m above a pocket where the slow creep starts (rims: nest 6 mm, hotel 8 mm)
 
 # Half-turn about the grasp x axis: the same top-down grasp with the fingers swapped.
 FLIP_ABOUT_APPROACH = make_transform(rotation=np.diag([1.0, -1.0, -1.0]))
@@ -182,10 +182,10 @@ class RobotBehaviours:
             ErrorCodes.IK_FAILED, f"the {arm} arm cannot reach {np.round(T_base_grasp[:3, 3], 3)}"
         )
 
-    def hotel_grasp_pose(self, slot: int, approach: bool) -> np.ndarray:
+    def hotel_grasp_pose(self, slot: int, approach: bool, releasing: bool = False) -> np.ndarray:
         with self._kinematics_lock:
             T_base_slot = self._kinematics.forward({}, f"hotel_slot_{slot}")
-        return T_base_slot @ self.motions.hotel.T_slot_grasp(approach)
+        return T_base_slot @ self.motions.hotel.T_slot_grasp(approach, releasing)
 
     def _tool_move(
         self,
@@ -280,7 +280,7 @@ class RobotBehaviours:
     def _hotel_motion(self, run: ActionRun, arm: str, name: str, slot: int) -> None:
         T_approach = self.hotel_grasp_pose(slot, approach=True)
         if name == "Nest":  # straight down into the pocket (back up: NestApproach)
-            T_nest = self.hotel_grasp_pose(slot, approach=False)
+            T_nest = self.hotel_grasp_pose(slot, approach=False, releasing=self.holding.get(arm, False))
             seed = run.sim(lambda sim: dict(sim.joint_positions()))
             self.into_pocket(run, arm, self.grasp_twin(arm, T_nest, seed), (0.0, 1.0))
             return

@@ -153,7 +153,8 @@ class MarkerMotionBehaviour:
         # with the height it shifts put a finger tip into the bench (seed 4029, "nothing between the
         # fingers"). Heading and position still come from the marker.
         T_base_site = tf.levelled(sighting.T_base_marker @ T_marker_site)
-        T_base_grasp = T_base_site @ self.grasp.T_slot_grasp(approach=False)
+        releasing = goal.target == "site" and self.behaviours.holding.get(arm, False)
+        T_base_grasp = T_base_site @ self.grasp.T_slot_grasp(approach=False, releasing=releasing)
         T_base_target = self.behaviours.grasp_twin(arm, T_base_grasp, seed)
         in_nest = goal.target == "site"  # slow only where the plate enters or leaves the nest
         speed = TOOL_SPEED_INTO_POCKET if in_nest else TOOL_SPEED_FREE

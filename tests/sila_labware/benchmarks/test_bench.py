@@ -1,7 +1,8 @@
 """The repeatability bench: seeded disturbances, a small real campaign, its table and its report.
 
 The campaign runs the real stack (sim node, sequencer, bridge, SiLA servers) through the CLI, as
-a user would; a replay of one seed must reproduce that trial's outcome.
+a user would; a replay of one seed runs it again with the same disturbances (not as the same run:
+the robot side's clock also runs while the robot software computes), and says so.
 """
 
 from __future__ import annotations
@@ -125,6 +126,9 @@ def test_small_campaign_table_is_consistent_replays_and_reports(tmp_path: Path) 
         o["seed"] for o in summary["outcomes"] if not o["success"]
     }
     assert summary["sim_seconds_median"] > 0 and summary["realtime_factor"] > 0
+    # the default levels include the sensor and calibration errors of the real robot
+    for flag in ("depth-noise-mm", "camera-mount-mm", "camera-mount-deg", "joint-offset-deg"):
+        assert summary["levels"][flag] > 0, flag
     assert done.returncode == (0 if summary["successes"] == 2 else 1), done.stderr[-2000:]
     for name in ("success_by_cause.png", "time_per_phase.png", "run_strip.png"):
         image = cv2.imread(str(report_dir / name))
@@ -136,6 +140,8 @@ def test_small_campaign_table_is_consistent_replays_and_reports(tmp_path: Path) 
     replay = run_bench("--replay", str(SEED + 1), "--json")
     replayed = json.loads(replay.stdout)
     assert replayed["trials"] == 1
+    assert "not the same run" in replayed["replay_repeats"]
+    assert "not the same run" in replay.stderr
     original = summary["outcomes"][1]
     assert (
         replayed["outcomes"][0]["seed"],
@@ -146,6 +152,14 @@ def test_small_campaign_table_is_consistent_replays_and_reports(tmp_path: Path) 
         original["success"],
         original["cause"],
     )
+
+
+def test_replay_says_it_repeats_the_disturbances_not_the_run() -> None:
+    shown = subprocess.run([*CLI, "bench", "--help"], capture_output=True, text=True, timeout=60)
+    assert shown.returncode == 0, shown.stderr
+    help_text = " ".join(shown.stdout.split())
+    assert "--replay SEED run the one trial with SEED again: the same disturbances" in help_text
+    assert "not the same run" in help_text
 
 
 def _robot_side_pids(domain_id: str) -> list[int]:
