@@ -22,12 +22,14 @@ import concurrent.futures
 import logging
 import threading
 import time
+import uuid
 from collections.abc import Callable
 from typing import Any
 
 from action_msgs.msg import GoalStatus
 from rclpy.action import ActionClient
 from rclpy.action.client import ClientGoalHandle
+from unique_identifier_msgs.msg import UUID
 
 from ros_bridge.errors import BridgeError, BridgeTimeout, ServerUnavailable
 from ros_bridge.goal_status import ActionGoal, ActionOutcome
@@ -172,10 +174,10 @@ class ActionCaller:
         return bool(self._runtime.call(self._client.server_is_ready))
 
     def wait_for_server(self, timeout_s: float = 10.0) -> None:
-        """Return once the server is discovered; raise ServerUnavailable naming it otherwise."""
+        """Return once a live server answers; raise ServerUnavailable naming it otherwise."""
         deadline = time.monotonic() + timeout_s
         while True:
-            if self.is_ready():
+            if self.is_ready() and self.answers(min(1.0, max(0.1, deadline - time.monotonic()))):
                 return
             if time.monotonic() >= deadline:
                 raise ServerUnavailable(
@@ -183,6 +185,29 @@ class ActionCaller:
                     f"not available after {timeout_s:.1f} s; is the robot side running in this ROS domain?"
                 )
             time.sleep(0.05)
+
+    def answers(self, timeout_s: float = 2.0) -> bool:
+        """Whether a live server answers a request now: a cancel request for a goal id nobody
+        sent (the server answers "unknown goal" and cancels nothing).
+
+        Why not `is_ready`: a server killed with SIGKILL stays discovered until its DDS lease
+        ends, so `is_ready` holds at once after a restart, and a goal sent then reached only the
+        dead server and was never answered. A server that answers is matched; its goal service,
+        discovered with it, is too."""
+        answered: concurrent.futures.Future = concurrent.futures.Future()
+
+        def ask_on_ros_thread() -> None:
+            nobodys_goal = ClientGoalHandle(self._client, UUID(uuid=list(uuid.uuid4().bytes)), None)
+            # rclpy offers cancel requests only through a goal handle; this one was never sent
+            request = self._client._cancel_goal_async(nobodys_goal)
+            request.add_done_callback(lambda done: _copy_ros_future(done, answered))
+
+        self._runtime.call(ask_on_ros_thread)
+        try:
+            answered.result(timeout=timeout_s)
+        except concurrent.futures.TimeoutError:
+            return False
+        return True
 
     def send(self, goal: Any, on_feedback: Callable[[GoalProgress], None] | None = None) -> ActionGoal:
         """Send `goal`; returns at once with its status (acceptance and result come later).

@@ -9,7 +9,9 @@ of steps on the sim thread (see action_run.ActionRun). Lives on: rclpy executor 
 from __future__ import annotations
 
 import logging
+import threading
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any
 
 from labware_interfaces.action import Dock, Gripper, MarkerMotion, NavigateToPoi, PlayMotion, Undock
@@ -42,19 +44,39 @@ ExecuteFn = Callable[[ActionRun, Any], dict]
 
 
 class RobotActivity:
-    """What the robot is doing, for /robot_state (written by goals, read by the publisher)."""
+    """What the robot is doing, for /robot_state (written by goals, read by the publisher).
+
+    Also what it did between two reads: a goal shorter than the publisher's period (a 2 s drive
+    at 50 times real time lasts 40 ms) would otherwise never show as navigating, and a SiLA
+    client following RobotState would miss the state altogether."""
 
     def __init__(self) -> None:
         self.state = ""  # "" (derive idle/docked from sensors), navigating, manipulating, error
         self.detail = ""
         self.last_error = ""
+        self._lock = threading.Lock()
+        self._begun: list[tuple[str, str]] = []  # since the last snapshot
 
-    def snapshot(self) -> tuple[str, str]:
-        if self.state:
-            return self.state, self.detail
-        if self.last_error:
-            return RobotState.STATE_ERROR, self.last_error
-        return "", self.detail
+    def begin(self, state: str, detail: str) -> None:
+        with self._lock:
+            self.state, self.detail = state, detail
+            self._begun.append((state, detail))
+
+    def snapshot(self) -> ActivityReport:
+        """The current (state or "", detail), and the activities begun and ended since the last call."""
+        with self._lock:
+            begun, self._begun = self._begun, []
+            if self.state:
+                return ActivityReport(self.state, self.detail, tuple(begun[:-1]))
+            current = (RobotState.STATE_ERROR, self.last_error) if self.last_error else ("", self.detail)
+            return ActivityReport(*current, tuple(begun))
+
+
+@dataclass(frozen=True)
+class ActivityReport:
+    state: str  # "" when no goal runs and no fault stands: idle or docked, as the sensors say
+    detail: str
+    passed: tuple[tuple[str, str], ...] = ()  # (state, detail) of goals that began and ended unseen
 
 
 class RobotActionServers:
@@ -109,7 +131,7 @@ class RobotActionServers:
             try:
                 self.slot.acquire(name)
                 acquired = True
-                self.activity.state, self.activity.detail = state, name.lstrip("/")
+                self.activity.begin(state, name.lstrip("/"))
                 run.feedback(0.0, "starting", 0.0, force=True)
                 extra = execute(run, goal_handle.request) or {}
                 for field_name, value in extra.items():

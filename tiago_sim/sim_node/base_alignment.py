@@ -33,7 +33,8 @@ log = logging.getLogger(__name__)
 
 HEAD_JOINTS = ("head_1_joint", "head_2_joint")
 CAMERA_FRAME = "head_camera_optical_frame"
-SEARCH_PAN_OFFSETS = (0.0, 0.45, -0.45, 0.9, -0.9)  # rad; the camera sees 63 deg across
+# rad; the camera sees 63 deg across. The second look repeats the first once the torso stands.
+SEARCH_PAN_OFFSETS = (0.0, 0.0, 0.45, -0.45, 0.9, -0.9)
 ALIGN_SPEED = 0.3  # m/s cap for the short final drive (the acceleration limit keeps it lower anyway)
 
 
@@ -66,16 +67,25 @@ def compose_planar(
     return a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], tf.wrap_angle(a[2] + b[2])
 
 
-def _search(run: ActionRun, head: dict[str, float], look: Any) -> Any:
+def _search(run: ActionRun, kinematics: RobotKinematics, target: np.ndarray, look: Any, lifting: Any) -> Any:
     """Point the head where the marker should be and look; if it is not in the image, pan left and
     right and look again (odometry drifts over a long drive: seed 316 arrived 18 cm and 5 deg off
-    its belief). Every extra look is logged; MARKER_NOT_FOUND only when all of them fail."""
+    its belief). Every extra look is logged; MARKER_NOT_FOUND only when all of them fail.
+
+    The first look happens while the torso still rises to the bench height; a torso left low by
+    an earlier motion rises for seconds and carried the marker out of the image's bottom edge. So
+    a further look first lets the torso arrive and aims from the joints read then."""
     failure: ActionAbort | None = None
     for index, pan_offset in enumerate(SEARCH_PAN_OFFSETS):
-        aim = {**head, "head_1_joint": head["head_1_joint"] + pan_offset}
         if index:
-            log.info("marker not in view: looking %.0f deg further %s", abs(math.degrees(pan_offset)),
-                     "left" if pan_offset > 0 else "right")  # fmt: skip
+            side = "left" if pan_offset > 0 else "right"
+            further = f"{abs(math.degrees(pan_offset)):.0f} deg further {side}"
+            log.info("marker not in view: looking %s", further if pan_offset else "again, the torso at rest")
+            if lifting is not None:
+                run.run_motion(lambda _sim: lifting, span=(0.0, 0.15))
+        joints = run.sim(lambda sim: dict(sim.joint_positions()))
+        head = head_angles_towards(kinematics, joints, target)
+        aim = {**head, "head_1_joint": head["head_1_joint"] + pan_offset}
         run.run_motion(lambda sim, aim=aim: sim.move_joints(aim), span=(0.0, 0.15))
         try:
             return look(run)
@@ -99,15 +109,15 @@ def align_base(
     `look(run)` takes an image and returns the marker sighting (T_base_marker); `working_joints`
     are torso/head targets that move while the base drives (e.g. the bench working posture).
     """
-    joints = run.sim(lambda sim: dict(sim.joint_positions()))
-    T_world_poi = station.work_pose().matrix()  # where the robot believes navigation left it
-    T_base_marker_expected = tf.invert(T_world_poi) @ station.T_world_marker()
-    head = head_angles_towards(kinematics, joints, T_base_marker_expected[:3, 3])
+    # Where odometry says the base stands, not the POI: a task may start where the last one
+    # ended, at the working pose 0.22 m nearer.
+    believed = run.sim(lambda sim: tuple(sim.odometry()))
+    T_base_marker_expected = tf.invert(tf.from_planar(*believed)) @ station.T_world_marker()
     # The torso starts rising at once (it is the slowest joint); the image is taken with the joint
     # readings of the same instant, so the camera pose stays exact while it moves.
     torso = {name: value for name, value in working_joints.items() if name not in HEAD_JOINTS}
     lifting = run.sim(lambda sim: sim.move_joints(torso)) if torso else None
-    sighting = _search(run, head, look)
+    sighting = _search(run, kinematics, T_base_marker_expected[:3, 3], look, lifting)
     T_marker_work = tf.invert(station.T_world_marker()) @ station.aligned_pose().matrix()
     correction = planar(sighting.T_base_marker @ T_marker_work)  # working pose in base_footprint
     odometry = run.sim(lambda sim: tuple(sim.odometry()))

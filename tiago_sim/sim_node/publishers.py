@@ -51,6 +51,7 @@ class RobotSnapshot:
     nests: list[NestReading] = field(default_factory=list)
     true_base_pose: tuple[float, float, float] | None = None  # simulator truth, for measurement only
     activity: tuple[str, str] = ("", "")  # (state or "", detail) of the action servers at that instant
+    passed_activities: tuple[tuple[str, str], ...] = ()  # goals begun and ended since the last snapshot
 
 
 def take_snapshot(sim: Any) -> RobotSnapshot:
@@ -122,14 +123,14 @@ class StatePublishers:
         sim_thread: SimThread,
         *,
         pois: Callable[[], dict[str, tuple[float, float, float]]],
-        activity: Callable[[], tuple[str, str]],
+        activity: Callable[[], Any],
         rate_hz: float = 20.0,
         camera_rate_hz: float = 2.0,
     ) -> None:
         self.node = node
         self.sim_thread = sim_thread
         self.pois = pois
-        self.activity = activity  # -> (state or "", detail)
+        self.activity = activity  # -> action_servers.ActivityReport
         self.latest: RobotSnapshot | None = None
         # Wide enough to cover the marker-guided final approach (the base works ~12 cm closer to
         # the table than the station's POI) plus navigation error; POIs lie metres apart.
@@ -175,7 +176,10 @@ class StatePublishers:
     def _snapshot_with_activity(self, sim: Any) -> RobotSnapshot:
         """Sensors and activity read at the same instant (on the sim thread): a state read later
         than the pose said "idle" beside the pose of a base still braking (10 cm off, under load)."""
-        return replace(take_snapshot(sim), activity=self.activity())
+        report = self.activity()
+        return replace(
+            take_snapshot(sim), activity=(report.state, report.detail), passed_activities=report.passed
+        )
 
     def _publish(self, snapshot: RobotSnapshot) -> None:
         self.latest = snapshot
@@ -187,6 +191,8 @@ class StatePublishers:
         joints.name = list(snapshot.joint_positions)
         joints.position = [float(v) for v in snapshot.joint_positions.values()]
         self.joint_pub.publish(joints)
+        for passed_state, detail in snapshot.passed_activities:  # each state shows, however short
+            self.robot_state_pub.publish(self.robot_state(replace(snapshot, activity=(passed_state, detail))))
         state = self.robot_state(snapshot)
         key = (
             state.state,

@@ -140,9 +140,11 @@ class SimThread:
             while not self._stop.is_set():
                 cpu_before = time.thread_time()
                 self._wake.clear()  # before draining: a job queued from here on sets it again
-                self._run_jobs(sim)
+                # Watchers first: they react to the last batch of steps (a fault that fires on a
+                # release) before a job reads the sensors, or a report could show the moment between.
                 if self._watchers:
                     self._run_watchers(sim)
+                self._run_jobs(sim)
                 cpu_after_jobs = time.thread_time()
                 self.job_cpu_s += cpu_after_jobs - cpu_before
                 if sim.busy():

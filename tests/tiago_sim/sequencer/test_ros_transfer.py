@@ -78,6 +78,11 @@ def set_parameter(robot: RosCaller, name: str, text: str) -> None:
     assert response.results[0].successful, response.results[0].reason
 
 
+def set_sim_float(robot: RosCaller, name: str, value: float) -> None:
+    response = robot.call_service(SetParameters, "/tiago_sim/set_parameters", parameter_request(name, value))
+    assert response.results[0].successful, response.results[0].reason
+
+
 def assert_feedback_regular(outcome: object, min_rate_hz: float = 2.0) -> None:
     times = outcome.feedback_times
     assert len(times) >= 3, "too little feedback"
@@ -320,21 +325,29 @@ def test_a_plate_knocked_out_of_the_nest_after_the_release_is_place_failed(robot
 
 
 def test_second_motion_while_busy_is_refused_and_cancel_stops_safely(robot: RosCaller) -> None:
+    """A motion sent while one of the task's steps runs is refused. The simulation runs at twice
+    real time here, so that step lasts seconds of wall time, not the few milliseconds that a
+    fast machine at 50 times real time left between "the step runs" and "the motion arrives"."""
     start = placement(robot).location
     assert start == "station:station_a:1", (
         f"precondition: the plate should be back in station_a:1, is {start}"
     )
-    handle = robot.send(GetLabware, "/get_labware", task_goal(GetLabware, "station_a", 1, 2))
-    assert handle.accepted
-    outcome = handle.outcome
-    ended = handle.get_result_async()
-    robot.wait_for(
-        lambda: ended.done() or any("approach" in f.phase for f in outcome.feedback),
-        TASK_TIMEOUT_S,
-        "the approach phase",
-    )
-    assert not ended.done(), f"GetLabware ended before its approach: {ended.result().result.message}"
-    busy = robot.call_action(PlayMotion, "/play_motion", PlayMotion.Goal(motion_name="Home"), timeout_s=30.0)
+    set_sim_float(robot, "realtime_factor_cap", 2.0)
+    try:
+        handle = robot.send(GetLabware, "/get_labware", task_goal(GetLabware, "station_a", 1, 2))
+        assert handle.accepted
+        outcome = handle.outcome
+        ended = handle.get_result_async()
+        robot.wait_for(  # the step's own feedback ("final approach: ..."): its goal runs
+            lambda: ended.done() or any(f.phase.startswith("final approach: ") for f in outcome.feedback),
+            TASK_TIMEOUT_S,
+            "the final approach running",
+        )
+        assert not ended.done(), f"GetLabware ended before its approach: {ended.result().result.message}"
+        home = PlayMotion.Goal(motion_name="Home")
+        busy = robot.call_action(PlayMotion, "/play_motion", home, timeout_s=30.0)
+    finally:
+        set_sim_float(robot, "realtime_factor_cap", 0.0)
     assert busy.result.error_code == ErrorCodes.BUSY, busy.result.message
     busy_task = robot.call_action(GetLabware, "/get_labware", task_goal(GetLabware, "station_b", 1, 1))
     assert busy_task.result.error_code == ErrorCodes.BUSY
