@@ -90,3 +90,30 @@ def test_demo_refuses_unparsable_yaml_in_one_line(tmp_path: Path) -> None:
     line = only_line(done.stderr)
     assert str(world) in line and "not valid YAML" in line, line
     assert done.stdout == ""
+
+
+def test_world_check_prints_the_table_and_draws_the_lab(tmp_path: Path) -> None:
+    picture = tmp_path / "lab.png"
+    done = subprocess.run(
+        [*CLI, "world", "check", str(DEFAULT_WORLD), "--png", str(picture)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert (done.returncode, done.stderr) == (0, "")
+    lines = done.stdout.splitlines()
+    assert lines[0] == f"default lab: {DEFAULT_WORLD} (floor 12 m)"
+    assert lines[2].split() == ["station_a", "3", "2", "station_a_work", "plate_001@1"]
+    assert lines[-1] == f"picture: {picture}" and picture.stat().st_size > 0
+
+
+@pytest.mark.parametrize(
+    ("arguments", "reason"),
+    [
+        (("world",), "the following arguments are required: {check}"),
+        (("world", "check"), "the following arguments are required: file"),
+    ],
+)
+def test_world_without_a_file_is_bad_usage(arguments: tuple[str, ...], reason: str) -> None:
+    done = subprocess.run([*CLI, *arguments], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 2 and reason in only_line(done.stderr)

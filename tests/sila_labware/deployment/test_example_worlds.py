@@ -17,7 +17,7 @@ from tests.helpers.sila_stack import DEFAULT_WORLD, start_stack
 EXAMPLES = sorted(path for path in DEFAULT_WORLD.parent.glob("*.yaml") if path != DEFAULT_WORLD)
 # what the demo moves in each: the plate, from, to
 EXPECTED = {
-    "four_nest_bench": ("plate_far", "bench_a/4", "bench_b/1"),
+    "two_benches": ("plate_b", "bench_a/2", "bench_b/1"),
     "three_stations": ("mp_001", "reader/1", "incubator/1"),
 }
 
