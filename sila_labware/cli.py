@@ -4,9 +4,11 @@
     sila-labware demo  --world FILE [--json] [--record DIR] [same options as serve]
     sila-labware bench --trials N --seed S [--json] [--report DIR] [--replay SEED] [levels] (bench_cli)
     sila-labware bluesky-demo --world FILE   (the same robot driven from a Bluesky RunEngine plan)
+    sila-labware world check FILE [--png OUT]   (validate a world file, draw it; deployment/world_file)
 
-Exit codes: 0 success, 1 the demo transfer failed or the stack could not start, 2 bad usage,
-130 `demo` or `bench` stopped by Ctrl-C or SIGTERM.
+Exit codes: 0 success, 1 the demo transfer failed or the stack could not start (`world check`: the
+file is invalid), 2 bad usage (an invalid world file included: every command with --world checks it
+first), 130 `demo` or `bench` stopped by Ctrl-C or SIGTERM.
 
 Stopping and clean-up: Ctrl-C (or SIGTERM) stops `serve`, `demo` and `bench` at any point, start-up
 included, within 5 s: the running transfer is abandoned (the robot is told to stop), the SiLA
@@ -39,6 +41,7 @@ from sila_labware.benchmarks.campaign_cli import (
     validate_bench,
     write_recorded_pictures,
 )
+from sila_labware.deployment.world_file import add_world_command, world_command, world_problems
 from sila_labware.servers.refusal_log import install_refusal_log_filter
 
 if TYPE_CHECKING:
@@ -62,7 +65,7 @@ def build_parser() -> argparse.ArgumentParser:
         prog="sila-labware", description="A TIAGo++ mobile manipulator as a SiLA 2 labware-transfer device."
     )
     subcommands = parser.add_subparsers(
-        dest="command", required=True, metavar="{serve,demo,bluesky-demo,bench}", parser_class=_Parser
+        dest="command", required=True, metavar="{serve,demo,bluesky-demo,bench,world}", parser_class=_Parser
     )
 
     def add_stack_options(sub: argparse.ArgumentParser) -> None:
@@ -142,10 +145,13 @@ def build_parser() -> argparse.ArgumentParser:
     )
     bluesky.add_argument("--verbose", action="store_true", help="log at INFO level")
     bluesky.set_defaults(port_base=50052)
+    add_world_command(subcommands, _Parser)
     return parser
 
 
 def _validate(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    if args.command == "world":
+        return
     if not args.world.is_file():
         parser.error(f"world file not found: {args.world}")
     if not 1 <= args.port_base <= 65535 - 16:
@@ -161,6 +167,9 @@ def _validate(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None
         parser.error(f"--domain-id {args.domain_id} is outside 0..232")
     if args.command == "bench":
         validate_bench(parser, args)
+    problems = world_problems(args.world)  # last: a child process, the slowest check
+    if problems:
+        parser.error("invalid world file: " + "\n".join(problems))
 
 
 class _StopRequest:
@@ -359,7 +368,13 @@ def _bench(args: argparse.Namespace) -> int:
         return bench_command(args, _deployment_options(args, ca_file))
 
 
-COMMANDS = {"serve": serve, "demo": demo, "bluesky-demo": bluesky_demo, "bench": _bench}
+COMMANDS = {
+    "serve": serve,
+    "demo": demo,
+    "bluesky-demo": bluesky_demo,
+    "bench": _bench,
+    "world": world_command,
+}
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -367,7 +382,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     _validate(parser, args)
     logging.basicConfig(
-        level=logging.INFO if args.verbose else logging.WARNING,
+        level=logging.INFO if getattr(args, "verbose", False) else logging.WARNING,
         format="%(asctime)s %(levelname)s %(name)s: %(message)s",
     )
     # sila2 logs every error a client receives as a traceback: a refusal becomes one WARNING line

@@ -258,8 +258,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         world = load_world(args.world)
     except WorldError as error:
-        # One line (YAML parser messages span several) that a parent process can show as it is.
-        sys.stderr.write(f"invalid world file: {' '.join(str(error).split())}\n")
+        # One line (a problem per line otherwise) that a parent process can show as it is.
+        sys.stderr.write(f"invalid world file: {'; '.join(error.problems)}\n")
         return INVALID_WORLD_EXIT_CODE
     from tiago_sim.physics.simulation import (
         Simulation,  # heavy import (PyBullet), only in the process that owns it

@@ -44,8 +44,12 @@ def test_the_world_names_nests_plates_and_the_workcell_in_the_labware_model():
     assert workcell.pois == tuple(sorted(world.pois))
 
 
-def test_work_poi_stands_in_front_of_the_nests_facing_them():
-    world = load_world()
+SHIPPED_WORLDS = sorted(DEFAULT_WORLD.parent.glob("*.yaml"))
+
+
+@pytest.mark.parametrize("world_file", SHIPPED_WORLDS, ids=[path.stem for path in SHIPPED_WORLDS])
+def test_work_poi_stands_in_front_of_the_nests_facing_them(world_file):
+    world = load_world(world_file)
     for station in world.stations:
         T_world_base = world.pois[station.poi].matrix()
         for sub in range(1, station.sub_positions + 1):

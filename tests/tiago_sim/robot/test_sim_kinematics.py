@@ -6,12 +6,13 @@ import numpy as np
 import pytest
 
 from tiago_sim import transforms as tf
-from tiago_sim.lab.world import load_world
+from tiago_sim.lab.world import DEFAULT_WORLD, load_world
 from tiago_sim.physics.simulation import Simulation
 from tiago_sim.robot import robot_model as rm
 from tiago_sim.robot.kinematics import RobotKinematics, top_down_grasp
 
 PLATE_HALF_HEIGHT = 0.01435 / 2
+SHIPPED_WORLDS = sorted(DEFAULT_WORLD.parent.glob("*.yaml"))
 
 
 @pytest.fixture(scope="module")
@@ -19,10 +20,11 @@ def kinematics() -> RobotKinematics:
     return RobotKinematics()
 
 
-def test_ik_reaches_every_nest_from_its_working_pose_and_both_hotel_slots(kinematics):
+@pytest.mark.parametrize("world_file", SHIPPED_WORLDS, ids=[path.stem for path in SHIPPED_WORLDS])
+def test_ik_reaches_every_nest_from_its_working_pose_and_both_hotel_slots(kinematics, world_file):
     """From where the marker-guided final approach parks the base (`work_standoff`), not from the
-    POI where navigation stops (farther back, out of the hotel's sweep)."""
-    world = load_world()
+    POI where navigation stops (farther back, out of the hotel's sweep); in every shipped world."""
+    world = load_world(world_file)
     seed = {
         "torso_lift_joint": 0.15,
         **dict(zip(rm.arm_joint_names("right"), (0.2, -1.1, -0.2, 1.94, -1.57, 1.37, 0.0), strict=True)),

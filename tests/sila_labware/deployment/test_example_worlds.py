@@ -1,0 +1,38 @@
+"""Each example world besides the default delivers one plate end to end: the whole stack (sim node,
+sequencer, bridge, SiLA servers) started on it and the demo's transfer (the first station's plate
+to the second station's first free nest), judged by physics ground truth.
+
+Why: an example world is a promise that the robot serves that layout; the robot is tuned to
+layouts like the default, and a layout that loads is not yet one it reaches (README, "Schema")."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from sila_labware.deployment.demo import run_demo
+from tests.helpers.sila_stack import DEFAULT_WORLD, start_stack
+
+EXAMPLES = sorted(path for path in DEFAULT_WORLD.parent.glob("*.yaml") if path != DEFAULT_WORLD)
+# what the demo moves in each: the plate, from, to
+EXPECTED = {
+    "two_benches": ("plate_b", "bench_a/2", "bench_b/1"),
+    "three_stations": ("mp_001", "reader/1", "incubator/1"),
+}
+
+
+def test_every_example_world_has_a_transfer_here() -> None:
+    assert sorted(path.stem for path in EXAMPLES) == sorted(EXPECTED)
+
+
+@pytest.mark.parametrize("world", EXAMPLES, ids=[path.stem for path in EXAMPLES])
+def test_an_example_world_delivers_the_demo_plate(tmp_path: Path, world: Path) -> None:
+    deployment = start_stack(tmp_path, insecure=True, world=world)
+    try:
+        report = run_demo(deployment, progress_stream=None)
+    finally:
+        deployment.stop()
+    assert (report.labware_id, report.source, report.destination) == EXPECTED[world.stem]
+    assert report.success, f"ground truth says the plate is not in its nest: {report}"
+    assert report.plate_position_error_mm is not None and report.plate_position_error_mm < 5.0

@@ -1,0 +1,81 @@
+"""`python -m tiago_sim.lab.world_check FILE [--png OUT]`: is a world file valid, and what is in it.
+
+Why a command: a technician editing a lab file wants every problem at once before starting the
+robot, and a look at the layout. `sila-labware world check` runs this module (and `serve`/`demo`
+run it before they start anything): the SiLA side does not import the simulation's packages.
+
+Exit codes: 0 valid, 1 invalid (every problem on stderr, one per line: `file: field: problem`),
+2 bad usage.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TextIO
+
+from labware_model.holders import HotelSlot, Nest
+from tiago_sim.lab.world import World, WorldError, load_world
+
+INVALID_WORLD_EXIT_CODE = 1
+
+
+def summary(world: World) -> str:
+    """A short table: the stations with marker, nests, POI and plates; the other POIs; labware types."""
+    plates_at: dict[str, list[str]] = {}
+    aboard = []
+    for plate, holder in world.plates.items():
+        if isinstance(holder, Nest):
+            plates_at.setdefault(holder.station, []).append(f"{plate.labware_id}@{holder.sub_position}")
+        elif isinstance(holder, HotelSlot):
+            aboard.append(f"{plate.labware_id}@{holder.index}")
+    rows = [("station", "marker", "nests", "POI", "plates")]
+    for station in world.stations:
+        plates = " ".join(plates_at.get(station.name, [])) or "-"
+        rows.append((station.name, str(station.marker_id), str(station.sub_positions), station.poi, plates))
+    widths = [max(len(row[column]) for row in rows) for column in range(len(rows[0]))]
+    lines = [f"{world.name}: {world.source} (floor {world.floor_size:g} m)"]
+    lines += [
+        "  " + "  ".join(cell.ljust(width) for cell, width in zip(row, widths, strict=True)).rstrip()
+        for row in rows
+    ]
+    station_pois = {station.poi for station in world.stations}
+    others = [name for name in world.pois if name not in station_pois]
+    lines.append(f"POIs: {', '.join(others)} (in front of the dock: {world.dock_poi}), and one per station")
+    lines.append(f"hotel: {world.hotel_slots} slots; {' '.join(aboard) or 'empty'}")
+    for name, labware in world.labware_types.items():
+        size = f"{labware.length * 1000:.1f} x {labware.width * 1000:.1f} x {labware.height * 1000:.1f} mm"
+        lines.append(f"labware type {name}: {size}, {labware.mass:g} kg")
+    return "\n".join(lines) + "\n"
+
+
+def check_world(path: Path, png: Path | None, out: TextIO, err: TextIO) -> int:
+    """Validate (and draw) a world file; the exit code."""
+    try:
+        world = load_world(path)
+    except WorldError as error:
+        err.write("".join(f"{line}\n" for line in error.problems))
+        return INVALID_WORLD_EXIT_CODE
+    out.write(summary(world))
+    if png is not None:
+        from tiago_sim.lab.world_picture import draw_world  # matplotlib: only when drawing
+
+        draw_world(world, png)
+        out.write(f"picture: {png}\n")
+    return 0
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(
+        prog="sila-labware world check", description="Validate a world file; optionally draw it."
+    )
+    parser.add_argument("world", type=Path, help="the world YAML")
+    parser.add_argument("--png", type=Path, default=None, metavar="OUT", help="write a top-down picture here")
+    args = parser.parse_args(argv)
+    return check_world(args.world, args.png, sys.stdout, sys.stderr)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
