@@ -66,7 +66,7 @@ from tiago_sim.sequencer.plans import (
 )
 from tiago_sim.sequencer.postconditions import topic_of, unmet
 from tiago_sim.sequencer.task_run import StepFailed, TaskRun
-from tiago_sim.sequencer.waits import describe_workcell, sleep, within
+from tiago_sim.sequencer.waits import describe_workcell, sleep, wait_answering, within
 
 log = logging.getLogger("tiago_sim.sequencer")
 
@@ -108,6 +108,7 @@ class Sequencer:
         node.create_subscription(RobotState, "/robot_state", self._on_robot_state, qos)
         node.create_subscription(StationStates, "/station_states", self._on_station_states, qos)
         self.active: TaskRun | None = None
+        self.answering: set[str] = set()  # action servers known to answer (waits.wait_answering)
         for kind, topic, plan in (
             (GetLabware, "/get_labware", get_plan),
             (PutLabware, "/put_labware", put_plan),
@@ -288,7 +289,8 @@ class Sequencer:
     async def _run_step(self, run: TaskRun, step: Step, which: str) -> None:
         kind, _topic = SUB_ACTIONS[step.action]
         client = self.clients[step.action]
-        await self._wait_ready(SUB_ACTIONS[step.action][1], client.server_is_ready)
+        server_wait_s = float(self.param("server_wait_s"))
+        await wait_answering(self.node, client, SUB_ACTIONS[step.action][1], server_wait_s, self.answering)
         goal = kind.Goal()
         for field_name, value in step.goal.items():
             setattr(goal, field_name, value)

@@ -9,12 +9,16 @@ uses. Lives on the sequencer's executor thread.
 from __future__ import annotations
 
 import logging
+import time
+import uuid
 from typing import Any
 
 from labware_interfaces.msg import ErrorCodes
 from labware_interfaces.srv import DescribeWorkcell
+from rclpy.action.client import ClientGoalHandle
 from rclpy.node import Node
 from rclpy.task import Future
+from unique_identifier_msgs.msg import UUID
 
 from labware_model.workcell import StationDescription, WorkcellDescription
 from tiago_sim.sequencer.task_run import StepFailed
@@ -53,6 +57,27 @@ async def within(node: Node, future: Future, seconds: float) -> bool:
         timer.cancel()
         node.destroy_timer(timer)
     return future.done()
+
+
+async def wait_answering(node: Node, client: Any, what: str, timeout_s: float, answered: set[str]) -> None:
+    """Wait until a live server of action `what` answers (once per action; StepFailed after
+    `timeout_s`). The probe is a cancel request for a goal id nobody sent: the server answers
+    "unknown goal" and cancels nothing.
+
+    Why not `server_is_ready` alone: a server killed with SIGKILL stays discovered until its DDS
+    lease ends, so after a restart of the robot side a goal could go to the dead server only."""
+    if what in answered:
+        return
+    deadline = time.monotonic() + timeout_s
+    while True:
+        if client.server_is_ready():
+            nobodys_goal = ClientGoalHandle(client, UUID(uuid=list(uuid.uuid4().bytes)), None)
+            if await within(node, client._cancel_goal_async(nobodys_goal), 1.0):
+                answered.add(what)
+                return
+        if time.monotonic() > deadline:
+            raise StepFailed(ErrorCodes.INTERNAL, f"robot not available: {what} does not answer")
+        await sleep(node, 0.1)
 
 
 async def describe_workcell(node: Node, client: Any, attempts: int, timeout_s: float) -> WorkcellDescription:
