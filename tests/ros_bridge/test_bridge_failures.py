@@ -107,3 +107,20 @@ def test_goals_still_open_when_the_runtime_ends_are_abandoned_at_once_naming_why
                     goal.wait(timeout_s=2.0)
             finally:
                 runtime.stop()
+
+
+def test_a_killed_action_server_does_not_count_as_ready() -> None:
+    """After SIGKILL the peer's server may stay discovered until its DDS lease ends; only an
+    answer counts. A goal sent on discovery alone reached the dead server and was never answered
+    (a robot side restarted under load, in CI)."""
+    with RosRuntime("bridge_test_killed_server") as runtime:
+        navigate = ActionCaller(runtime, NavigateToPoi, "/navigate_to_poi")
+        with running_echo_peer(GOAL_S) as peer:
+            navigate.wait_for_server(timeout_s=15.0)
+            assert navigate.answers(timeout_s=5.0), "a live server answers"
+            peer.kill()
+            peer.wait(timeout=10)
+            assert navigate.is_ready(), "discovery forgot the killed server at once (here: after 20 s)"
+            assert not navigate.answers(timeout_s=1.0), "a killed server answered"
+            with pytest.raises(BridgeError, match="not available after 1.0 s"):
+                navigate.wait_for_server(timeout_s=1.0)
