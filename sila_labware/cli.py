@@ -1,7 +1,8 @@
 """Command line entry point `sila-labware`: serve the robot and its stations over SiLA, or run the demo.
 
-    sila-labware serve --world FILE [--host 127.0.0.1] [--port-base N] [--insecure] [--ca-file PATH]
-    sila-labware demo  --world FILE [--json] [--record DIR] [same options as serve]
+    sila-labware serve --world FILE [--host H] [--port-base N] [--insecure] [--ca-file PATH] [--pace X]
+                       [--print-config json]   (connection details as JSON: deployment/connection_config)
+    sila-labware demo  --world FILE [--json] [--record DIR] [--pace X] [stack options as serve]
     sila-labware bench --trials N --seed S [--json] [--report DIR] [--replay SEED] [levels] (bench_cli)
     sila-labware bluesky-demo --world FILE   (the same robot driven from a Bluesky RunEngine plan)
     sila-labware world check FILE [--png OUT]   (validate a world file, draw it; deployment/world_file)
@@ -41,6 +42,8 @@ from sila_labware.benchmarks.campaign_cli import (
     validate_bench,
     write_recorded_pictures,
 )
+from sila_labware.deployment.connection_config import add_print_config_argument, print_servers, write_config
+from sila_labware.deployment.pacing import add_pace_argument, pace_problem
 from sila_labware.deployment.world_file import add_world_command, world_command, world_problems
 from sila_labware.servers.refusal_log import install_refusal_log_filter
 
@@ -114,10 +117,13 @@ def build_parser() -> argparse.ArgumentParser:
         "serve", help="run the simulated robot and serve it and its stations over SiLA"
     )
     add_stack_options(serve)
+    add_pace_argument(serve)
+    add_print_config_argument(serve)
     demo = subcommands.add_parser(
         "demo", help="serve, then move the plate from the first station to the second"
     )
     add_stack_options(demo)
+    add_pace_argument(demo)
     demo.add_argument(
         "--json", action="store_true", help="print one JSON object with the outcome and timings"
     )
@@ -165,6 +171,8 @@ def _validate(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None
             parser.error(f"--name: {error}")
     if args.domain_id is not None and not 0 <= args.domain_id <= 232:
         parser.error(f"--domain-id {args.domain_id} is outside 0..232")
+    if problem := pace_problem(getattr(args, "pace", None)):
+        parser.error(problem)
     if args.command == "bench":
         validate_bench(parser, args)
     problems = world_problems(args.world)  # last: a child process, the slowest check
@@ -190,6 +198,7 @@ class _StopRequest:
 def _deployment_options(args: argparse.Namespace, ca_file: Path) -> DeploymentOptions:
     from sila_labware.deployment.stack import DeploymentOptions
 
+    record = getattr(args, "record", None)
     if args.insecure:
         logger.warning(
             "serving WITHOUT encryption (--insecure): for tests only, the SiLA standard forbids it"
@@ -204,14 +213,10 @@ def _deployment_options(args: argparse.Namespace, ca_file: Path) -> DeploymentOp
         domain_id=args.domain_id,
         ready_timeout_s=args.ready_timeout,
         log_dir=args.log_dir,
-        extra_sim_arguments=_record_arguments(args),
+        extra_sim_arguments=[] if record is None else ["--record-dir", str(record / "frames")],
         lab_name=args.name,
+        pace=getattr(args, "pace", None),
     )
-
-
-def _record_arguments(args: argparse.Namespace) -> list[str]:
-    record = getattr(args, "record", None)
-    return [] if record is None else ["--record-dir", str(record / "frames")]
 
 
 @contextmanager
@@ -232,17 +237,6 @@ def _interrupt_on_signals() -> None:
 
     signal.signal(signal.SIGINT, interrupt_between_starts)
     signal.signal(signal.SIGTERM, interrupt_between_starts)
-
-
-def _print_servers(deployment, stream) -> None:
-    for served in deployment.servers:
-        stream.write(f"{served.role:8} {served.name:32} {served.host}:{served.port}\n")
-    if deployment.ca_file is not None:
-        stream.write(f"CA file for clients: {deployment.ca_file.resolve()}\n")
-    for child in deployment.children.children:
-        stream.write(f"robot side: {child.name} pid {child.popen.pid}\n")
-    stream.write(f"ROS domain: {deployment.domain_id}\n")
-    stream.flush()
 
 
 def _start(args: argparse.Namespace) -> tuple[Deployment | None, _StopRequest]:
@@ -270,9 +264,12 @@ def serve(args: argparse.Namespace) -> int:
     if deployment is None:
         return 0 if stop.event.is_set() else 1
     try:
-        _print_servers(deployment, sys.stdout)
-        sys.stdout.write("serving; Ctrl-C stops\n")
-        sys.stdout.flush()
+        listing = sys.stderr if args.print_config else sys.stdout  # stdout: the JSON alone
+        print_servers(deployment, listing)
+        if args.print_config == "json":
+            write_config(deployment, sys.stdout)
+        listing.write("serving; Ctrl-C stops\n")
+        listing.flush()
         while not stop.event.wait(0.5):
             deployment.check_healthy()
         return 0
@@ -325,7 +322,7 @@ def _run_demo(args: argparse.Namespace, ca_file: Path) -> tuple[DemoReport, str]
         deployment = Deployment(_deployment_options(args, ca_file))
         deployment.start()
         ending = _TRANSFERRED
-        _print_servers(deployment, sys.stderr)
+        print_servers(deployment, sys.stderr)
         report = run_demo(deployment, progress_stream=sys.stderr)
         if interrupt_requested():  # a library turned the KeyboardInterrupt into its own error
             raise KeyboardInterrupt

@@ -30,6 +30,7 @@ from ros_bridge.errors import BridgeError
 from ros_bridge.robot_link import RobotLink
 from ros_bridge.runtime import RosRuntime
 from sila_labware.deployment.lab_name import lab_name_of, robot_server_name, station_server_name
+from sila_labware.deployment.pacing import sim_pace_arguments
 from sila_labware.deployment.processes import ProcessGroup, interrupts_held, ros_environment
 from sila_labware.deployment.supervisor import RobotSideSupervisor
 from sila_labware.device.robot_controller import RobotController
@@ -62,6 +63,8 @@ class DeploymentOptions:
     """Restart the robot side when a child ends (see sila_labware.deployment.supervisor)."""
     lab_name: str = ""
     """Carried by every server name (see lab_name.py); empty: the world file's."""
+    pace: float | None = None
+    """Times real time the simulation runs at (see pacing.py); None: as fast as it can."""
 
 
 @dataclass(frozen=True)
@@ -85,12 +88,14 @@ def choose_domain_id(requested: int | None) -> int:
     return reserve_domain_id()
 
 
-def start_robot_side(children: ProcessGroup, world: Path, extra_sim_arguments: Sequence[str] = ()) -> None:
+def start_robot_side(
+    children: ProcessGroup, world: Path, extra_sim_arguments: Sequence[str] = (), pace: float | None = None
+) -> None:
     """Start the robot side's ROS nodes (simulation node, sequencer) as children."""
     for name, module in ROBOT_SIDE_MODULES:
         arguments = ["--world", str(world)]
         if name == "sim_node":
-            arguments += list(extra_sim_arguments)
+            arguments += [*sim_pace_arguments(pace), *extra_sim_arguments]
         children.start_python_module(name, module, arguments)
 
 
@@ -140,7 +145,9 @@ class Deployment:
     def _start_robot_side(self) -> None:
         with self._lifecycle_lock:
             self._refuse_if_stopping()
-            start_robot_side(self.children, self.options.world, self.options.extra_sim_arguments)
+            start_robot_side(
+                self.children, self.options.world, self.options.extra_sim_arguments, self.options.pace
+            )
 
     def _new_runtime(self) -> RosRuntime:
         return RosRuntime("sila_labware_bridge", domain_id=self.domain_id).start()

@@ -40,6 +40,7 @@ def start_stack(
     discovery: bool = False,
     world: Path = DEFAULT_WORLD,
     lab_name: str = "",
+    pace: float | None = None,
 ) -> Deployment:
     deployment = Deployment(
         DeploymentOptions(
@@ -52,6 +53,7 @@ def start_stack(
             ready_timeout_s=120.0,
             log_dir=tmp_dir / "logs",
             lab_name=lab_name,
+            pace=pace,
         )
     )
     deployment.start()

@@ -68,6 +68,8 @@ def test_help_lists_subcommands() -> None:
         (("fly",), "invalid choice: 'fly'"),
         (("serve", "--bogus"), "unrecognized arguments: --bogus"),
         (("serve", "--port-base", "many"), "invalid int value: 'many'"),
+        (("serve", "--pace", "0"), "--pace 0 is outside 0 < X <= 1000"),
+        (("demo", "--pace", "1001"), "--pace 1001 is outside 0 < X <= 1000"),
         (("demo", "--world", "/no/such/world.yaml"), "world file not found: /no/such/world.yaml"),
     ],
 )

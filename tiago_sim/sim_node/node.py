@@ -1,6 +1,7 @@
 """The simulated TIAGo++ as a ROS 2 node: the one process that owns PyBullet.
 
     python -m tiago_sim.sim_node --world FILE [--seed N] [--realtime-factor-cap X]
+        [--idle-realtime-factor X]
 
 Threads: the sim thread (sim_thread.SimThread) owns the Simulation and steps it; a
 MultiThreadedExecutor spins the node on the main thread; action execute callbacks and timers only
@@ -205,6 +206,12 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         default=None,
         help="at most this many times real time (default: none)",
     )
+    parser.add_argument(
+        "--idle-realtime-factor",
+        type=float,
+        default=1.0,
+        help="times real time while no motion runs (default: %(default)s)",
+    )
     parser.add_argument("--motions", type=Path, default=DEFAULT_MOTIONS_FILE, help="keyframe motions YAML")
     parser.add_argument(
         "--disturbance-seed", type=int, default=None, help="seed of tiago_sim.measuring.disturbances"
@@ -266,7 +273,9 @@ def main(argv: list[str] | None = None) -> int:
     )
 
     sim_thread = SimThread(
-        lambda: make_simulation(Simulation, world, args), realtime_factor_cap=args.realtime_factor_cap
+        lambda: make_simulation(Simulation, world, args),
+        realtime_factor_cap=args.realtime_factor_cap,
+        idle_realtime_factor=args.idle_realtime_factor,
     )
 
     def build(node: Node) -> SimNode:

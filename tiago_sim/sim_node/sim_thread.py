@@ -147,7 +147,18 @@ class SimThread:
                 self._run_jobs(sim)
                 cpu_after_jobs = time.thread_time()
                 self.job_cpu_s += cpu_after_jobs - cpu_before
-                if sim.busy():
+                busy = sim.busy()
+                factor = self.realtime_factor_cap if busy else self.idle_realtime_factor
+                if factor == paced_factor and factor is not None and factor > 0:
+                    ahead_s = ahead_of_wall_s(factor)
+                    if ahead_s > 0:
+                        # Woken for a job while the clock is ahead of the wall: no step, or every
+                        # job would advance the clock on top of the wall time it took (idle: about
+                        # 1 s a transfer; in motion a whole batch of steps per job, which ran a
+                        # motion capped at 1x real time at several times real time).
+                        self._wake.wait(min(ahead_s, 0.05))
+                        continue
+                if busy:
                     for _ in range(_STEPS_BETWEEN_JOB_CHECKS):
                         sim.step()
                         self.steps += 1
@@ -156,17 +167,7 @@ class SimThread:
                     self.busy_sim_s += sim.sim_time - self.sim_time
                     self.busy_cpu_s += time.thread_time() - cpu_after_jobs
                     self.sim_time = sim.sim_time
-                    factor = self.realtime_factor_cap
                 else:
-                    factor = self.idle_realtime_factor
-                    if factor == paced_factor and factor is not None and factor > 0:
-                        ahead_s = ahead_of_wall_s(factor)
-                        if ahead_s > 0:
-                            # Woken for a job while the idle clock is ahead of the wall: no step, or
-                            # every job would advance the idle robot's clock by one physics step
-                            # (up to 1/60 s) on top of the wall time it took (about 1 s a transfer).
-                            self._wake.wait(min(ahead_s, 0.05))
-                            continue
                     sim.step()
                     self.steps += 1
                     self.sim_time = sim.sim_time

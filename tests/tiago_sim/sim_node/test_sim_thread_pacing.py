@@ -33,3 +33,35 @@ def test_an_idle_clock_follows_the_wall_clock_through_a_burst_of_jobs():
         assert sim_after - sim_paced <= wall_s + 2 * step_s, (sim_after - sim_paced, wall_s)
     finally:
         thread.stop()
+
+
+class _EndlessMotion:
+    """Stands in for a Simulation with a motion that never ends: only the clock matters here."""
+
+    def __init__(self) -> None:
+        self.sim_time = 0.0
+
+    def busy(self) -> bool:
+        return True
+
+    def step(self) -> None:
+        self.sim_time += 1 / 240
+
+
+def test_a_capped_motion_follows_the_wall_clock_through_a_burst_of_jobs():
+    """Each job once woke the thread for a whole batch of steps: at a cap of 1x real time, a motion
+    ran several times faster than real time (a paced demo took 11 s wall for 55 s simulated)."""
+    thread = SimThread(_EndlessMotion, realtime_factor_cap=1.0)
+    thread.start()
+    try:
+        time.sleep(0.3)  # paced from here
+        sim_before, wall_before = thread.run(lambda sim: sim.sim_time), time.monotonic()
+        for _ in range(300):  # one after the other: each wakes the thread on its own
+            thread.run(lambda sim: sim.sim_time)
+        time.sleep(0.2)
+        sim_after = thread.run(lambda sim: sim.sim_time)
+        wall_s = time.monotonic() - wall_before
+        batch_s = 24 / 240  # the most one wake may step
+        assert sim_after - sim_before <= wall_s + 2 * batch_s, (sim_after - sim_before, wall_s)
+    finally:
+        thread.stop()

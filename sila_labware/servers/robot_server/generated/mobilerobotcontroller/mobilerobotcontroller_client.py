@@ -40,6 +40,12 @@ class MobileRobotControllerClient:
     vertical axis, counter-clockwise positive, within -pi to pi) in radians. Only one motion command runs at
     a time; a second one is refused with "Robot Busy" instead of being queued.
 
+    Remaining times: the estimated remaining execution time of this server's observable commands (these
+    and those of the "Labware Transfer Manipulator Controller" feature) is given in wall-clock seconds at
+    the robot's current pace. A simulated robot may run faster or slower than real time; its estimates,
+    made on its own clock, are converted at the pace it is measured to run, so that a client can count
+    them down on its own clock. At a pace of 1 (a real robot's timing) the two clocks are one.
+
     """
 
     PointsOfInterest: ClientUnobservableProperty[List[PointOfInterestName]]

@@ -1,0 +1,42 @@
+"""`--pace X`: run the simulation at X times real time, busy and idle alike.
+
+Why both: the sim node paces motion (`--realtime-factor-cap`) and the pauses between motions
+(`--idle-realtime-factor`) separately; with one pace for both, a transfer's wall time matches its
+simulated time divided by the pace, and a client sees a robot that keeps a real robot's timing
+(pace 1) or a steady multiple of it. Without a pace the simulation moves as fast as the machine
+allows and idles at real time, as before.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+MAX_PACE = 1000.0
+"""Beyond this the sleeps that pace the simulation are shorter than its steps: no pace at all."""
+
+
+def add_pace_argument(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--pace",
+        type=float,
+        default=None,
+        metavar="X",
+        help="run the simulation at X times real time, 0 < X <= 1000 (1.0: a real robot's timing; "
+        "default: as fast as the machine allows)",
+    )
+
+
+def pace_problem(pace: float | None) -> str | None:
+    """Why `pace` is no usable pace (None: it is, or none was asked for)."""
+    if pace is None:
+        return None
+    if not 0.0 < pace <= MAX_PACE:  # also refuses nan
+        return f"--pace {pace:g} is outside 0 < X <= {MAX_PACE:g}"
+    return None
+
+
+def sim_pace_arguments(pace: float | None) -> list[str]:
+    """The sim node's arguments for `pace` (none: its defaults, unpaced motion)."""
+    if pace is None:
+        return []
+    return ["--realtime-factor-cap", repr(pace), "--idle-realtime-factor", repr(pace)]
