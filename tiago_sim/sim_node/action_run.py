@@ -110,6 +110,15 @@ class ActionRun:
                 raise ActionAbort(ErrorCodes.INTERNAL, "simulation did not answer in time")
             self.feedback(self.progress, self.phase, self.remaining_s)
 
+    def stop(self, motions: list[Any]) -> None:
+        """Cancel the motions among `motions` still running and wait until they stand: a goal
+        that ends (cancelled or failed) stops what it started beside the motion it followed."""
+        running = [motion for motion in motions if motion is not None and not motion.done]
+        for motion in running:
+            self.sim_thread.call(lambda _sim, motion=motion: motion.cancel())
+        for motion in running:
+            motion.finished.wait(5.0)
+
     def run_motion(
         self,
         start: Callable[[Any], Any],

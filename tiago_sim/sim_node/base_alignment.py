@@ -117,19 +117,27 @@ def align_base(
     # readings of the same instant, so the camera pose stays exact while it moves.
     torso = {name: value for name, value in working_joints.items() if name not in HEAD_JOINTS}
     lifting = run.sim(lambda sim: sim.move_joints(torso)) if torso else None
-    sighting = _search(run, kinematics, T_base_marker_expected[:3, 3], look, lifting)
-    T_marker_work = tf.invert(station.T_world_marker()) @ station.aligned_pose().matrix()
-    correction = planar(sighting.T_base_marker @ T_marker_work)  # working pose in base_footprint
-    odometry = run.sim(lambda sim: tuple(sim.odometry()))
-    goal = compose_planar(odometry, correction)
-    log.info(
-        "aligning at %s: working pose at x %.3f y %.3f m, yaw %.1f deg from here",
-        station.name, correction[0], correction[1], math.degrees(correction[2]),
-    )  # fmt: skip
-    head_at_work = {name: value for name, value in working_joints.items() if name in HEAD_JOINTS}
-    turning = run.sim(lambda sim: sim.move_joints(head_at_work)) if head_at_work else None
-    run.run_motion(lambda sim: sim.drive_to(*goal, speed=ALIGN_SPEED), span=(0.2, 0.9))
-    for motion, span in ((lifting, (0.9, 0.95)), (turning, (0.95, 1.0))):
-        if motion is not None:
-            run.run_motion(lambda _sim, motion=motion: motion, span=span)
+    background = [lifting]  # motions running beside the ones this goal follows
+    try:
+        sighting = _search(run, kinematics, T_base_marker_expected[:3, 3], look, lifting)
+        T_marker_work = tf.invert(station.T_world_marker()) @ station.aligned_pose().matrix()
+        correction = planar(sighting.T_base_marker @ T_marker_work)  # working pose in base_footprint
+        odometry = run.sim(lambda sim: tuple(sim.odometry()))
+        goal = compose_planar(odometry, correction)
+        log.info(
+            "aligning at %s: working pose at x %.3f y %.3f m, yaw %.1f deg from here",
+            station.name, correction[0], correction[1], math.degrees(correction[2]),
+        )  # fmt: skip
+        head_at_work = {name: value for name, value in working_joints.items() if name in HEAD_JOINTS}
+        turning = run.sim(lambda sim: sim.move_joints(head_at_work)) if head_at_work else None
+        background.append(turning)
+        run.run_motion(lambda sim: sim.drive_to(*goal, speed=ALIGN_SPEED), span=(0.2, 0.9))
+        for motion, span in ((lifting, (0.9, 0.95)), (turning, (0.95, 1.0))):
+            if motion is not None:
+                run.run_motion(lambda _sim, motion=motion: motion, span=span)
+    except BaseException:
+        # A cancel or a failure stops the torso and the head too: the robot reported standing
+        # still while its torso rose on (a cancel during the search, at 1x real time).
+        run.stop(background)
+        raise
     return look(run)  # from the working pose: later tool moves reuse it while the base stands

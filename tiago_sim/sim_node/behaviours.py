@@ -86,9 +86,13 @@ class RobotBehaviours:
         if run.sim(lambda sim: sim.is_docked()):
             raise ActionAbort(ErrorCodes.DOCKED, "the robot is docked: undock first")
         lowering = self._lower_torso(run)
-        run.run_motion(lambda sim: sim.drive_to(*pose), span=(0.0, 0.95))
-        if lowering is not None:
-            run.run_motion(lambda _sim: lowering, span=(0.95, 1.0))
+        try:
+            run.run_motion(lambda sim: sim.drive_to(*pose), span=(0.0, 0.95))
+            if lowering is not None:
+                run.run_motion(lambda _sim: lowering, span=(0.95, 1.0))
+        except BaseException:
+            run.stop([lowering])  # a cancelled drive stops the torso too
+            raise
         return {}
 
     def _lower_torso(self, run: ActionRun) -> Any:
