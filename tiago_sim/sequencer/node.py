@@ -65,6 +65,7 @@ from tiago_sim.sequencer.plans import (
     retreat_steps,
 )
 from tiago_sim.sequencer.postconditions import topic_of, unmet
+from tiago_sim.sequencer.step_durations import StepDurations
 from tiago_sim.sequencer.task_run import StepFailed, TaskRun
 from tiago_sim.sequencer.waits import describe_workcell, sleep, wait_answering, within
 
@@ -109,6 +110,7 @@ class Sequencer:
         node.create_subscription(StationStates, "/station_states", self._on_station_states, qos)
         self.active: TaskRun | None = None
         self.answering: set[str] = set()  # action servers known to answer (waits.wait_answering)
+        self.step_durations = StepDurations({})  # robot seconds per step kind, learned as steps run
         for kind, topic, plan in (
             (GetLabware, "/get_labware", get_plan),
             (PutLabware, "/put_labware", put_plan),
@@ -213,8 +215,8 @@ class Sequencer:
             result.labware_id = labware_id_at_source(
                 goal_handle.request, self.robot_state, self.station_states, from_hotel
             )
-            estimates = {a: float(self.param(f"estimates_s.{a}")) for a in SUB_ACTIONS}
-            run = TaskRun(goal_handle, kind.Feedback, plan, estimates)
+            self.step_durations.table = {a: float(self.param(f"estimates_s.{a}")) for a in SUB_ACTIONS}
+            run = TaskRun(goal_handle, kind.Feedback, plan, [self.step_durations.estimate(s) for s in plan])
             self.active = run
             try:
                 run.publish()
@@ -302,6 +304,7 @@ class Sequencer:
                 run.phase = f"{step.phase}: {message.feedback.phase}"
 
         log.info("%s: %s", which, step.describe())
+        started = self._robot_seconds()
         sent = client.send_goal_async(goal, feedback_callback=on_feedback)
         if not await within(self.node, sent, float(self.param("server_wait_s"))):
             # an answer that comes after all must not leave a goal running that nobody waits for
@@ -327,6 +330,12 @@ class Sequencer:
         if step.expect_holding and not sub_result.holding:
             raise StepFailed(ErrorCodes.GRASP_FAILED, f"{step.describe()}: nothing between the fingers")
         run.step_progress, run.step_remaining_s = 1.0, 0.0
+        self.step_durations.record(step, self._robot_seconds() - started)
+
+    def _robot_seconds(self) -> float:
+        """The robot's clock as its last state report carried it (simulated time in the twin)."""
+        stamp = self.robot_state.stamp if self.robot_state is not None else None
+        return stamp.sec + stamp.nanosec * 1e-9 if stamp is not None else 0.0
 
     async def _result_within_step_timeout(self, sub_goal: Any, step: Step, which: str) -> Any:
         """The sub-goal's result; past `step_timeout_s` the sub-goal is cancelled and the step fails."""

@@ -25,11 +25,11 @@ class TaskRun:
     """Progress bookkeeping of one task goal (lives on the executor thread)."""
 
     def __init__(
-        self, goal_handle: Any, feedback_type: type, plan: list[Step], estimates: dict[str, float]
+        self, goal_handle: Any, feedback_type: type, plan: list[Step], durations: list[float]
     ) -> None:
         self.goal_handle = goal_handle
         self.feedback_type = feedback_type
-        self.durations = [max(estimates.get(step.action, 3.0), 0.1) for step in plan]
+        self.durations = durations  # estimated robot seconds per step (step_durations)
         self.total = sum(self.durations)
         self.index = 0
         self.step_progress = 0.0

@@ -1,0 +1,34 @@
+"""Step durations: the table until a step kind has run, then what it took (robot seconds)."""
+
+from __future__ import annotations
+
+import pytest
+
+from tiago_sim.sequencer.plans import Step
+from tiago_sim.sequencer.step_durations import FALLBACK_S, StepDurations, step_kind
+
+APPROACH = Step("marker_motion", {"station": "a", "sub_position": 1, "target": "work_pose"})
+TOOL_MOVE = Step("marker_motion", {"station": "a", "sub_position": 1, "target": "site"})
+
+
+def test_a_step_kind_names_the_action_and_what_it_does() -> None:
+    assert step_kind(APPROACH) == "marker_motion:work_pose"
+    assert step_kind(Step("navigate", {"poi": "station_b_work"})) == "navigate:station_b_work"
+    assert step_kind(Step("play_motion", {"motion_name": "Tuck"})) == "play_motion:Tuck"
+
+
+def test_the_table_serves_until_the_kind_ran_then_what_it_took() -> None:
+    durations = StepDurations({"marker_motion": 2.4})
+    assert durations.estimate(APPROACH) == durations.estimate(TOOL_MOVE) == 2.4
+    durations.record(APPROACH, 5.0)
+    assert durations.estimate(APPROACH) == 5.0
+    assert durations.estimate(TOOL_MOVE) == 2.4, "another kind of the same action keeps the table's value"
+    durations.record(APPROACH, 6.0)
+    assert durations.estimate(APPROACH) == pytest.approx(5.5)
+
+
+def test_an_unknown_action_gets_the_fallback_and_a_clock_restart_is_ignored() -> None:
+    durations = StepDurations({})
+    assert durations.estimate(Step("gripper", {"command": "open"})) == FALLBACK_S
+    durations.record(APPROACH, -40.0)
+    assert durations.estimate(APPROACH) == FALLBACK_S
