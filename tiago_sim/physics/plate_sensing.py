@@ -25,6 +25,13 @@ from tiago_sim.physics.scene import plate_bottom_pose
 from tiago_sim.physics.seating import PoseInNest, SeatingLimits
 
 NEST_SENSOR_RANGE = 0.02  # m: presence sensor sees a plate whose centre is this close to the site
+# m: and whose bottom is at most this far above the pocket floor. A nest's sensor is a short-range
+# proximity sensor in the pocket floor: a plate resting on a lead-in's rim (3 mm up at its centre,
+# the one failure mode of the 200 trials at 7b59091) is not seen, so the robot reports it as not
+# placed instead of delivered. A seated plate lies within the success check's 1 mm.
+NEST_SENSOR_GAP = 0.0015
+HOTEL_SENSOR_GAP = 0.01  # m: the hotel pockets' sensors see a plate anywhere on their ramps; and
+# where a plate is, as ground truth: one resting on a nest's rim is at that nest, not seated in it
 
 
 class PlateSensing:
@@ -59,11 +66,11 @@ class PlateSensing:
         return points
 
     @staticmethod
-    def _plate_near(T_world_site: np.ndarray, bottoms: list[tuple[str, np.ndarray]]) -> str:
+    def _plate_near(T_world_site: np.ndarray, bottoms: list[tuple[str, np.ndarray]], max_gap: float) -> str:
         """The plate whose bottom centre the presence sensor of this site sees, or ""."""
         for labware_id, point in bottoms:
             offset = T_world_site[:3, :3].T @ (point - T_world_site[:3, 3])
-            if math.hypot(offset[0], offset[1]) < NEST_SENSOR_RANGE and abs(offset[2]) < 0.01:
+            if math.hypot(offset[0], offset[1]) < NEST_SENSOR_RANGE and -0.01 < offset[2] < max_gap:
                 return labware_id
         return ""
 
@@ -77,16 +84,21 @@ class PlateSensing:
             ]
         return self._nest_sites_cache
 
-    def _nest_occupants(self) -> list[tuple[Nest, str]]:
-        """(nest, the plate physically in it or "") for every nest: ground truth."""
+    def _nest_occupants(self, max_gap: float = NEST_SENSOR_GAP) -> list[tuple[Nest, str]]:
+        """(nest, the plate in it or "") for every nest: what the sensors see, or with a wider
+        `max_gap` the ground truth of where a plate is (a plate on a rim is at that nest)."""
         bottoms = self._plate_bottom_points()
-        return [(nest, self._plate_near(T_world_site, bottoms)) for nest, T_world_site in self._nest_sites()]
+        sites = self._nest_sites()
+        return [(nest, self._plate_near(T_world_site, bottoms, max_gap)) for nest, T_world_site in sites]
 
     def _hotel_occupants(self) -> list[tuple[HotelSlot, str]]:
         """(slot, the plate physically in it or "") for every hotel pocket: ground truth."""
         bottoms = self._plate_bottom_points()
         return [
-            (HotelSlot(index), self._plate_near(self._robot.link_pose(f"hotel_slot_{index}"), bottoms))
+            (
+                HotelSlot(index),
+                self._plate_near(self._robot.link_pose(f"hotel_slot_{index}"), bottoms, HOTEL_SENSOR_GAP),
+            )
             for index in range(1, self._world.hotel_slots + 1)
         ]
 
@@ -127,7 +139,7 @@ class PlateSensing:
         for _side, gripper in self._grippers.items():
             if gripper.attached_id == labware_id or gripper.touching() == labware_id:
                 return GRIPPER
-        for nest, present in self._nest_occupants():
+        for nest, present in self._nest_occupants(HOTEL_SENSOR_GAP):
             if present == labware_id:
                 return nest
         for slot, present in self._hotel_occupants():
