@@ -31,11 +31,20 @@ CLI = [sys.executable, "-m", "sila_labware.cli"]
 SEED = 4242
 
 
-def run_bench(*arguments: str, timeout_s: float = 900.0) -> subprocess.CompletedProcess:
+def run_bench(*arguments: str, timeout_s: float = 240.0) -> subprocess.CompletedProcess:
+    """`bench` as a user runs it. Past `timeout_s` (inside pytest's 300 s) it is stopped as Ctrl-C
+    would, so its robot side is stopped too, and the test fails with what it printed (a run hung
+    once in CI, and SIGKILL had lost its output)."""
     stack = ["--insecure", "--no-discovery", "--port-base", str(free_port_base(4))]
-    return subprocess.run(
-        [*CLI, "bench", *stack, *arguments], capture_output=True, text=True, timeout=timeout_s
-    )
+    command = [*CLI, "bench", *stack, *arguments]
+    with subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as bench:
+        try:
+            stdout, stderr = bench.communicate(timeout=timeout_s)
+        except subprocess.TimeoutExpired:
+            bench.send_signal(signal.SIGINT)
+            stdout, stderr = bench.communicate(timeout=30.0)
+            pytest.fail(f"bench did not finish within {timeout_s:.0f} s; it printed:\n{stderr[-4000:]}")
+    return subprocess.CompletedProcess(command, bench.returncode, stdout, stderr)
 
 
 def test_bench_flag_defaults_are_the_sim_default_level() -> None:
