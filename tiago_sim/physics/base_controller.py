@@ -4,7 +4,7 @@ Why this shape: the base is kinematic in the plane (a constraint follows the int
 speed- and acceleration-limited body velocity), which is stable in PyBullet and honours the
 real drive's limits. The wheel encoders see the base's real motion with a seeded scale error and
 noise per wheel, so odometry drifts like a real robot's; drive motions close the loop on
-odometry only. Lives on the sim thread.
+the pose estimate (odometry plus localisation's correction). Lives on the sim thread.
 """
 
 from __future__ import annotations
@@ -78,6 +78,16 @@ class DiffDriveBase:
         self.rng = rng
         # per-wheel radius errors (calibration), drawn once: the systematic part of odometry drift
         self.wheel_scale = 1.0 + odometry_noise * rng.standard_normal(2)
+        # localisation's correction (x, y, yaw of the odometry frame in the map); identity until a
+        # localiser sets it. Drives close their loop on ``estimate()``, never on raw odometry.
+        self.map_from_odom = (0.0, 0.0, 0.0)
+
+    def estimate(self) -> tuple[float, float, float]:
+        """The base's pose in the map as the robot believes it: odometry with localisation's correction."""
+        ox, oy, oyaw = self.odom
+        tx, ty, tyaw = self.map_from_odom
+        c, s = math.cos(tyaw), math.sin(tyaw)
+        return (tx + c * ox - s * oy, ty + s * ox + c * oy, wrap_angle(tyaw + oyaw))
 
     def command(self, v: float, w: float) -> None:
         self.v_cmd = min(max(v, -rm.MAX_LINEAR_SPEED), rm.MAX_LINEAR_SPEED)
@@ -136,7 +146,7 @@ class DiffDriveBase:
 
 
 class DriveMotion(Motion):
-    """Turn towards the goal, drive, then turn to the goal heading; closed loop on odometry.
+    """Turn towards the goal, drive, then turn to the goal heading; closed loop on the pose estimate.
 
     ``reverse`` drives backwards (for docking); ``stop_when`` ends the drive early with success
     (e.g. the dock contact closes).
@@ -165,11 +175,11 @@ class DriveMotion(Motion):
         self.remaining_s = self._estimate_remaining_s(self._distance())
 
     def _distance(self) -> float:
-        x, y, _ = self.base.odom
+        x, y, _ = self.base.estimate()
         return math.hypot(self.goal[0] - x, self.goal[1] - y)
 
     def _heading_error(self) -> float:
-        x, y, yaw = self.base.odom
+        x, y, yaw = self.base.estimate()
         bearing = math.atan2(self.goal[1] - y, self.goal[0] - x)
         if self.reverse:
             bearing += math.pi
@@ -177,7 +187,7 @@ class DriveMotion(Motion):
 
     def _estimate_remaining_s(self, distance: float) -> float:
         """What is left of the drive in the current phase and after it, from TIAGo's limits."""
-        x, y, yaw = self.base.odom
+        x, y, yaw = self.base.estimate()
         moving = distance > POSITION_TOLERANCE * 2
         bearing = math.atan2(self.goal[1] - y, self.goal[0] - x) + (math.pi if self.reverse else 0.0)
         if self.phase == "aligning" or not moving:
@@ -226,7 +236,7 @@ class DriveMotion(Motion):
             w = HEADING_GAIN * heading_error if distance > 0.05 else 0.0
             base.command(v, w)
         else:  # aligning
-            error = wrap_angle(self.goal[2] - base.odom[2])
+            error = wrap_angle(self.goal[2] - base.estimate()[2])
             within = abs(error) < YAW_TOLERANCE * 0.5
             base.command(0.0, 0.0 if within else self._turn_rate(error))
             if within and base.stopped():
@@ -251,7 +261,7 @@ def docking_motion(
     charging contacts) says so; each stage with its time estimate, so the remaining time counts
     the slow last stretch from the start."""
     beyond = (dock.x - DOCK_OVERTRAVEL * math.cos(dock.yaw), dock.y - DOCK_OVERTRAVEL * math.sin(dock.yaw))
-    x, y, yaw = base.odom
+    x, y, yaw = base.estimate()
     bearing = math.atan2(approach.y - y, approach.x - x)
     approach_s = drive_duration_s(
         wrap_angle(bearing - yaw),

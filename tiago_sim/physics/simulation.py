@@ -263,6 +263,11 @@ class Simulation:
         x, y, yaw = self.base.odom
         return float(x), float(y), float(yaw)
 
+    def pose_estimate(self) -> tuple[float, float, float]:
+        """The base's pose in the map as the robot believes it (odometry + localisation's correction)."""
+        x, y, yaw = self.base.estimate()
+        return float(x), float(y), float(yaw)
+
     def joint_positions(self) -> dict[str, float]:
         return self.robot.joint_positions()
 
