@@ -29,11 +29,13 @@ from ros_bridge.domain import reserve_domain_id
 from ros_bridge.errors import BridgeError
 from ros_bridge.robot_link import RobotLink
 from ros_bridge.runtime import RosRuntime
+from ros_bridge.simulation_link import SimulationLink
 from sila_labware.deployment.lab_name import lab_name_of, robot_server_name, station_server_name
 from sila_labware.deployment.pacing import sim_pace_arguments
 from sila_labware.deployment.processes import ProcessGroup, interrupts_held, ros_environment
 from sila_labware.deployment.supervisor import RobotSideSupervisor
 from sila_labware.device.robot_controller import RobotController
+from sila_labware.device.simulated_lab import SimulatedLab
 from sila_labware.device.station_controller import StationController
 from sila_labware.servers.robot_server.server import Server as RobotServer
 from sila_labware.servers.serving import start_sila_server
@@ -117,6 +119,7 @@ class Deployment:
         self.link: RobotLink | None = None
         self.workcell: WorkcellDescription | None = None
         self.robot: RobotController | None = None
+        self.simulated_lab: SimulatedLab | None = None
         self.servers: list[ServedServer] = []
         self.ca_file: Path | None = None
         self.supervisor: RobotSideSupervisor | None = None
@@ -191,13 +194,19 @@ class Deployment:
     def _start_servers(self) -> None:
         assert self.robot is not None and self.workcell is not None and self.link is not None
         lab = self.options.lab_name or lab_name_of(self.options.world)
+        stations = [StationController(self.link, station) for station in self.workcell.stations]
+        # the robot side this deployment starts is always the simulation: offer its controls
+        self.simulated_lab = SimulatedLab(SimulationLink(self.link), self.robot, stations, self.options.pace)
         planned: list[tuple[SilaServer, str, str]] = [
-            (RobotServer(self.robot, name=robot_server_name(lab)), "robot", "")
+            (
+                RobotServer(self.robot, name=robot_server_name(lab), simulated_lab=self.simulated_lab),
+                "robot",
+                "",
+            )
         ]
-        for station in self.workcell.stations:
-            controller = StationController(self.link, station)
-            server = StationServer(controller, name=station_server_name(lab, station.name))
-            planned.append((server, "station", station.name))
+        for controller in stations:
+            server = StationServer(controller, name=station_server_name(lab, controller.station.name))
+            planned.append((server, "station", controller.station.name))
         authority = None if self.options.insecure else CertificateAuthority()
         for offset, (server, role, station_name) in enumerate(planned):
             port = self.options.port_base + offset

@@ -189,6 +189,11 @@ class SiteSequence:
         self._lock = threading.Lock()
         self._nests = {index: NestExpectation(NestPhase.IDLE) for index in range(1, sub_positions + 1)}
 
+    def reset(self) -> None:
+        """Every nest idle, nothing announced (after a lab reset)."""
+        with self._lock:
+            self._nests = {index: NestExpectation(NestPhase.IDLE) for index in self._nests}
+
     def nest(self, sub_position: int) -> NestExpectation:
         with self._lock:
             return self._nests[sub_position]

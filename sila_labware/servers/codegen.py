@@ -36,6 +36,7 @@ SERVER_FEATURES: dict[str, tuple[str, ...]] = {
         "LabwareInventory.sila.xml",
         "CancelController.sila.xml",
         "SimulationController.sila.xml",
+        "SimulatedLabController.sila.xml",
     ),
     "station_server": ("LabwareTransferSiteController.sila.xml", "SimulationController.sila.xml"),
 }

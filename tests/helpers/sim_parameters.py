@@ -5,18 +5,12 @@ One place builds the ParameterValue for a Python value, so every test sets param
 
 from __future__ import annotations
 
-from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
+from rcl_interfaces.msg import Parameter
 from rcl_interfaces.srv import SetParameters
 
 from ros_bridge.runtime import RosRuntime
 from ros_bridge.services import ServiceCaller
-
-
-def parameter_value(value: str | float) -> ParameterValue:
-    """A string stays a string; every number becomes a double."""
-    if isinstance(value, str):
-        return ParameterValue(type=ParameterType.PARAMETER_STRING, string_value=value)
-    return ParameterValue(type=ParameterType.PARAMETER_DOUBLE, double_value=float(value))
+from ros_bridge.simulation_link import parameter_value
 
 
 def parameter_request(name: str, value: str | float) -> SetParameters.Request:

@@ -62,6 +62,11 @@ class RobotActivity:
             self.state, self.detail = state, detail
             self._begun.append((state, detail))
 
+    def clear(self) -> None:
+        """Nothing running, no error standing (after a lab reset)."""
+        with self._lock:
+            self.state, self.detail, self.last_error, self._begun = "", "", "", []
+
     def snapshot(self) -> ActivityReport:
         """The current (state or "", detail), and the activities begun and ended since the last call."""
         with self._lock:

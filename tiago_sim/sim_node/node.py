@@ -42,6 +42,7 @@ from tiago_sim.node_main import spin_node
 from tiago_sim.robot.motion_library import DEFAULT_MOTIONS_FILE, load_motions
 from tiago_sim.sim_node.action_servers import RobotActionServers
 from tiago_sim.sim_node.behaviours import RobotBehaviours
+from tiago_sim.sim_node.lab_reset import LabReset
 from tiago_sim.sim_node.marker_motion import MarkerMotionBehaviour
 from tiago_sim.sim_node.publishers import StatePublishers
 from tiago_sim.sim_node.sim_thread import SimThread
@@ -86,6 +87,8 @@ class SimNode:
         self.publishers = StatePublishers(
             node, sim_thread, pois=self.current_pois, activity=self.actions.activity.snapshot
         )
+        self.lab_reset = LabReset(node, sim_thread, self.actions.slot)
+        self.lab_reset.hooks.append(self._forget_the_old_lab)
         node.create_service(DescribeWorkcell, "/describe_workcell", self._describe_workcell)
         node.create_service(CheckPlacement, "/check_placement", self._check_placement)
         node.add_on_set_parameters_callback(self._on_parameters)
@@ -156,6 +159,21 @@ class SimNode:
             # Checked after every batch of steps: a wall-clock timer could miss a fast drive (seen
             # under CI load: a 1 s drive went by without the check seeing the base at speed).
             self.sim_thread.watch(self.plate_faults.drop_if_driving)
+
+    def _forget_the_old_lab(self) -> None:
+        """After a reset: no fault stands, no grasp is remembered, no error shows."""
+        self.occluders = Occluders(self.world)
+        self.plate_faults = PlateFaults()
+        self.node.set_parameters(
+            [
+                Parameter("fault.occlude_marker", value=""),
+                *(Parameter(name, value="") for name in PLATE_FAULTS),
+            ]
+        )
+        self.behaviours.grasp_flipped.clear()
+        self.behaviours.holding.clear()
+        self.marker_motion.last_sighting = None
+        self.actions.activity.clear()
 
     def current_pois(self) -> dict[str, tuple[float, float, float]]:
         pois = {}

@@ -45,6 +45,7 @@ class SimThread:
         # Set by call() and stop(): a thread pacing an idle robot wakes for a new job at once.
         self._wake = threading.Event()
         self._ready: Future = Future()
+        self._replacement: Any = None  # a rebuilt Simulation the loop takes over (see rebuild)
         # Checks that must see every batch of steps (not a wall-clock sample of them); sim thread only.
         self._watchers: list[Callable[[Any], bool]] = []
         self.realtime_factor_cap = realtime_factor_cap
@@ -86,6 +87,24 @@ class SimThread:
         """`call` and wait for the result."""
         return self.call(job).result(timeout=timeout_s)
 
+    def rebuild(self, timeout_s: float = 30.0) -> float:
+        """Build the Simulation anew from its factory, in place of the running one (a lab reset:
+        plates, robot and disturbances as at start, no process restarted). Its clock goes on from
+        the old one's, so /clock never runs backwards; watchers end. Returns the sim time it
+        resumed at. Callers make sure no goal runs (the action servers' motion slot)."""
+
+        def replace(old: Any) -> float:
+            new = self._factory()
+            new.sim_time = old.sim_time
+            self._watchers = []
+            close = getattr(old, "close", None)
+            if callable(close):
+                close()
+            self._replacement = new
+            return float(new.sim_time)
+
+        return self.run(replace, timeout_s)
+
     def watch(self, watcher: Callable[[Any], bool]) -> None:
         """Run `watcher(sim)` on the sim thread after every batch of steps (at most
         _STEPS_BETWEEN_JOB_CHECKS steps apart, whatever the load) until it returns True."""
@@ -106,6 +125,8 @@ class SimThread:
                 future.set_result(job(sim))
             except BaseException as error:  # noqa: BLE001 - handed to the waiting thread
                 future.set_exception(error)
+            if self._replacement is not None:
+                return  # the jobs after a rebuild act on the new Simulation
 
     def _run_maybe_profiled(self) -> None:
         profile_path = os.environ.get(PROFILE_ENV)
@@ -145,6 +166,9 @@ class SimThread:
                 if self._watchers:
                     self._run_watchers(sim)
                 self._run_jobs(sim)
+                if self._replacement is not None:
+                    sim, self._replacement = self._replacement, None
+                    wall_start, sim_start, paced_factor = time.monotonic(), sim.sim_time, None
                 cpu_after_jobs = time.thread_time()
                 self.job_cpu_s += cpu_after_jobs - cpu_before
                 busy = sim.busy()

@@ -1,6 +1,7 @@
 # Created by sila2.code_generator 0.14.0 (new-package); hand-maintained since: regeneration never touches it.
 """The robot's SiLA server: the standard manipulator feature plus our motion and inventory features,
-and the SiLA core features CancelController, LockController and SimulationController.
+and the SiLA core features CancelController, LockController and SimulationController; with a
+`SimulatedLab` (simulated robots only) also SimulatedLabController.
 
 It is handed a `RobotController` (built on a running ROS bridge); the feature implementations
 take their behaviour from it. `cancellable_commands` tracks the running robot commands for
@@ -14,6 +15,7 @@ from uuid import UUID, uuid4
 from sila2.server import SilaServer
 
 from sila_labware.device.robot_controller import RobotController
+from sila_labware.device.simulated_lab import SimulatedLab
 from sila_labware.servers.finished_commands import FinishedCommandReaper
 from sila_labware.servers.grpc_interceptors import serve_with_interceptors
 from sila_labware.servers.initiation_checks import InitiationChecks, check_labware_transfer
@@ -26,11 +28,13 @@ from .feature_implementations.labwaretransfermanipulatorcontroller_impl import (
     LabwareTransferManipulatorControllerImpl,
 )
 from .feature_implementations.mobilerobotcontroller_impl import MobileRobotControllerImpl
+from .feature_implementations.simulatedlabcontroller_impl import SimulatedLabControllerImpl
 from .feature_implementations.simulationcontroller_impl import SimulationControllerImpl
 from .generated.cancelcontroller import CancelControllerFeature
 from .generated.labwareinventory import LabwareInventoryFeature
 from .generated.labwaretransfermanipulatorcontroller import LabwareTransferManipulatorControllerFeature
 from .generated.mobilerobotcontroller import MobileRobotControllerFeature
+from .generated.simulatedlabcontroller import SimulatedLabControllerFeature
 from .generated.simulationcontroller import SimulationControllerFeature
 
 
@@ -41,6 +45,7 @@ class Server(SilaServer):
         server_uuid: UUID | None = None,
         name: str | None = None,
         description: str | None = None,
+        simulated_lab: SimulatedLab | None = None,
     ):
         if name is None:
             name = "TIAGo Labware Robot"
@@ -77,6 +82,10 @@ class Server(SilaServer):
 
         self.simulationcontroller = SimulationControllerImpl(self)
         self.set_feature_implementation(SimulationControllerFeature, self.simulationcontroller)
+
+        if simulated_lab is not None:  # a simulated robot only: never offered for a real one
+            self.simulatedlabcontroller = SimulatedLabControllerImpl(self, simulated_lab)
+            self.set_feature_implementation(SimulatedLabControllerFeature, self.simulatedlabcontroller)
 
         # answers that must come before sila2 handles a call: a wrong lock token, a bad parameter
         initiation_checks = InitiationChecks()

@@ -34,7 +34,11 @@ STANDARD_MANIPULATOR_FDL = STANDARD_DIR / "LabwareTransferManipulatorController-
 STANDARD_MANIPULATOR_PROTO = STANDARD_DIR / "LabwareTransferManipulatorController-v1_0.proto"
 OUR_MANIPULATOR_FDL = FEATURES_DIR / "LabwareTransferManipulatorController.sila.xml"
 OUR_SITE_FDL = FEATURES_DIR / "LabwareTransferSiteController.sila.xml"
-OWN_FEATURES = ("MobileRobotController.sila.xml", "LabwareInventory.sila.xml")
+OWN_FEATURES = (
+    "MobileRobotController.sila.xml",
+    "LabwareInventory.sila.xml",
+    "SimulatedLabController.sila.xml",
+)
 OUR_CANCEL_FDL = FEATURES_DIR / "CancelController.sila.xml"
 OUR_SIMULATION_FDL = FEATURES_DIR / "SimulationController.sila.xml"
 STANDARD_SIMULATION_FDL = Path(standard_simulation.__file__).parent / "SimulationController-v1_0.sila.xml"
@@ -188,7 +192,7 @@ def descriptor_differences(
 # ---------------------------------------------------------------------------------------------------------
 
 
-def test_features_directory_holds_the_six_definitions() -> None:
+def test_features_directory_holds_the_seven_definitions() -> None:
     names = sorted(path.name for path in FEATURES_DIR.glob("*.sila.xml"))
     expected = [OUR_MANIPULATOR_FDL, OUR_SITE_FDL, OUR_CANCEL_FDL, OUR_SIMULATION_FDL]
     assert names == sorted([*(path.name for path in expected), *OWN_FEATURES]), (

@@ -11,6 +11,7 @@ from . import (
     labwareinventory,
     labwaretransfermanipulatorcontroller,
     mobilerobotcontroller,
+    simulatedlabcontroller,
     simulationcontroller,
 )
 
@@ -27,6 +28,8 @@ class Client(SilaClient):
 
     MobileRobotController: mobilerobotcontroller.MobileRobotControllerClient
 
+    SimulatedLabController: simulatedlabcontroller.SimulatedLabControllerClient
+
     SimulationController: simulationcontroller.SimulationControllerClient
 
     _expected_features: Set[FullyQualifiedFeatureIdentifier] = {
@@ -37,6 +40,7 @@ class Client(SilaClient):
             "org.silastandard/instruments.labware.manipulation/LabwareTransferManipulatorController/v1"
         ),
         FullyQualifiedFeatureIdentifier("org.labwaretransfer/robotics.mobile/MobileRobotController/v1"),
+        FullyQualifiedFeatureIdentifier("org.labwaretransfer/simulation/SimulatedLabController/v1"),
         FullyQualifiedFeatureIdentifier("org.silastandard/core/SimulationController/v1"),
     }
 
@@ -112,6 +116,21 @@ class Client(SilaClient):
         self._register_defined_execution_error_class(
             mobilerobotcontroller.MobileRobotControllerFeature.defined_execution_errors["MotionStopped"],
             mobilerobotcontroller.MotionStopped,
+        )
+
+        self._register_defined_execution_error_class(
+            simulatedlabcontroller.SimulatedLabControllerFeature.defined_execution_errors["RobotBusy"],
+            simulatedlabcontroller.RobotBusy,
+        )
+
+        self._register_defined_execution_error_class(
+            simulatedlabcontroller.SimulatedLabControllerFeature.defined_execution_errors["ResetFailed"],
+            simulatedlabcontroller.ResetFailed,
+        )
+
+        self._register_defined_execution_error_class(
+            simulatedlabcontroller.SimulatedLabControllerFeature.defined_execution_errors["FaultRefused"],
+            simulatedlabcontroller.FaultRefused,
         )
 
         self._register_defined_execution_error_class(

@@ -1,0 +1,120 @@
+"""SimulatedLabController over SiLA: reset the lab, inject and clear faults, pace, simulated time.
+
+Real parts: the whole stack (sim node with PyBullet, sequencer, bridge over DDS, SiLA servers over
+gRPC). Ground truth (the sim node's /check_placement) only checks what the feature claims.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterator
+
+import pytest
+from sila2.framework import DefinedExecutionError, ValidationError
+
+from labware_model.holders import Nest
+from tests.helpers.sila_stack import start_stack
+from tests.helpers.transfer_steps import Cell, finish, wait_for_progress
+
+PLATE = "plate_001"
+A1, B1 = ("station_a", 1), ("station_b", 1)
+
+
+@pytest.fixture(scope="module")
+def cell(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Cell]:
+    deployment = start_stack(tmp_path_factory.mktemp("simulated_lab"), insecure=True)
+    yield Cell(deployment)
+    deployment.stop()
+
+
+def lab_controls(cell: Cell):  # noqa: ANN201 - the sila2 dynamic client feature
+    return cell.robot.SimulatedLabController
+
+
+def reset(cell: Cell) -> float:
+    started = time.monotonic()
+    lab_controls(cell).ResetLab()
+    return time.monotonic() - started
+
+
+def test_the_feature_reports_simulated_time_pace_and_no_fault(cell: Cell) -> None:
+    lab = lab_controls(cell)
+    first = lab.SimulatedTime.get()
+    time.sleep(0.5)
+    assert lab.SimulatedTime.get() > first > 0.0
+    assert lab.RealTimeFactor.get() > 0.0
+    assert lab.Pace.get() == 0.0
+    assert lab.ActiveFaults.get() == []
+
+
+def test_a_removed_plate_is_gone_until_the_reset_puts_it_back(cell: Cell) -> None:
+    lab = lab_controls(cell)
+    lab.InjectFault(Fault="RemovePlate", Target=PLATE)
+    assert lab.ActiveFaults.get() == [f"RemovePlate {PLATE}"]
+    assert not cell.deployment.link.check_placement(PLATE, Nest(*A1)).in_nest
+    took_s = reset(cell)
+    assert cell.deployment.link.check_placement(PLATE, Nest(*A1)).in_nest
+    assert lab.ActiveFaults.get() == []
+    assert took_s < 10.0
+
+
+def test_a_reset_after_a_transfer_puts_plate_robot_and_inventory_back(cell: Cell) -> None:
+    cell.transfer(A1, B1, PLATE)
+    assert cell.location(PLATE) == (False, "station_b", 1)
+    reset(cell)
+    link = cell.deployment.link
+    assert link.check_placement(PLATE, Nest(*A1)).in_nest
+    assert cell.location(PLATE) == (False, "station_a", 1)
+    assert link.wait_for_robot_status(lambda status: status.docked, 5.0).docked
+    assert cell.nest_occupied()[A1] and not cell.nest_occupied()[B1]
+    cell.transfer(A1, B1, PLATE)  # the protocol state is fresh: the same transfer runs again
+    assert link.check_placement(PLATE, Nest(*B1)).in_nest
+    reset(cell)
+
+
+def test_reset_and_remove_are_refused_while_the_robot_drives(cell: Cell) -> None:
+    lab = lab_controls(cell)
+    motion = cell.robot.MobileRobotController
+    finish(motion.Undock())
+    lab.SetPace(Pace=1.0)  # a drive of seconds, not a tenth of one
+    drive = motion.DriveToPointOfInterest(PointOfInterest="station_b_work")
+    wait_for_progress(drive, 0.05)
+    with pytest.raises(DefinedExecutionError, match="RobotBusy"):
+        lab.ResetLab()
+    with pytest.raises(DefinedExecutionError, match="RobotBusy"):
+        lab.InjectFault(Fault="RemovePlate", Target=PLATE)
+    lab.InjectFault(Fault="OccludeMarker", Target="station_b")  # meant to strike during a command
+    lab.SetPace(Pace=0.0)
+    finish(drive)
+    lab.ClearFaults()
+    assert lab.ActiveFaults.get() == []
+    reset(cell)
+
+
+@pytest.mark.parametrize(
+    ("fault", "target", "named"),
+    [
+        ("RemovePlate", "no_such_plate", "no_such_plate"),
+        ("OccludeMarker", "station_z", "station_z"),
+        ("Explode", PLATE, "Explode"),
+    ],
+)
+def test_bad_fault_input_is_a_validation_error_naming_it(
+    cell: Cell, fault: str, target: str, named: str
+) -> None:
+    with pytest.raises(ValidationError, match=named):
+        lab_controls(cell).InjectFault(Fault=fault, Target=target)
+    assert lab_controls(cell).ActiveFaults.get() == []
+
+
+def test_pace_is_set_at_run_time_and_refused_outside_its_range(cell: Cell) -> None:
+    lab = lab_controls(cell)
+    with pytest.raises(ValidationError):
+        lab.SetPace(Pace=-1.0)
+    lab.SetPace(Pace=2.0)
+    assert lab.Pace.get() == 2.0
+    started_wall, started_sim = time.monotonic(), lab.SimulatedTime.get()
+    time.sleep(2.0)
+    ratio = (lab.SimulatedTime.get() - started_sim) / (time.monotonic() - started_wall)
+    lab.SetPace(Pace=0.0)
+    assert 1.5 < ratio < 2.5  # idle at the set pace (default idle: real time)
