@@ -76,6 +76,13 @@ ALLOWED: dict[str, set[str]] = {
         "sila_labware.servers",
         "sila_labware.deployment",
     },
+    # the simulated lab for downstream projects' tests (pytest plugin)
+    "sila_labware.testing": {
+        "ros_bridge",
+        "sila_labware.client",
+        "sila_labware.servers",
+        "sila_labware.deployment",
+    },
     "sila_labware.cli": {
         "ros_bridge",
         "ros_bridge.bluesky",

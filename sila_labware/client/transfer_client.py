@@ -88,12 +88,14 @@ class LabwareTransferClient:
             self._robot = self._open(robot, root_certs, insecure)
             self._manipulator = self._feature(self._robot, "LabwareTransferManipulatorController", robot)
             self._sites: dict[str, Any] = {}
+            self._sub_positions: dict[str, int] = {}  # per station, as its server offers them
             for address in stations:
                 site = self._feature(
                     self._open(address, root_certs, insecure), "LabwareTransferSiteController", address
                 )
                 for offered in self._call("AvailableHandoverPositions", site.AvailableHandoverPositions.get):
                     self._sites[offered.Position] = site
+                    self._sub_positions[offered.Position] = int(offered.SubPosition)
         except BaseException:
             self.close()
             raise
@@ -311,6 +313,12 @@ class LabwareTransferClient:
         if whole < 1 or isinstance(sub_position, bool):
             raise ParameterRejected(
                 f"sub-position {sub_position!r} of {station} is not a whole number from 1",
+                command=command,
+                parameter="HandoverPosition",
+            )
+        if whole > self._sub_positions[station]:
+            raise ParameterRejected(
+                f"{station} has sub-positions 1..{self._sub_positions[station]}, not {whole}",
                 command=command,
                 parameter="HandoverPosition",
             )

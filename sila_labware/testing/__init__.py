@@ -1,0 +1,1 @@
+"""A simulated lab for other projects' tests: the pytest plugin and what it stands on."""
