@@ -40,10 +40,14 @@ from setuptools.build_meta import (  # noqa: F401 - the hooks pip calls besides 
 ROOT = Path(__file__).resolve().parents[1]
 INTERFACES = ROOT / "ros_bridge" / "interfaces" / "labware_interfaces"
 PACKAGE = "labware_interfaces"
-MANYLINUX_PATHS = re.compile(r"/opt/python/cp3\d+-cp3\d+/(?:lib/python3\.\d+/site-packages/numpy/_core/include|include/python3\.\d+)")
+MANYLINUX_PATHS = re.compile(
+    r"/opt/python/cp3\d+-cp3\d+/(?:lib/python3\.\d+/site-packages/numpy/_core/include|include/python3\.\d+)"
+)
 
 
-def build_wheel(wheel_directory: str, config_settings: dict | None = None, metadata_directory: str | None = None) -> str:
+def build_wheel(
+    wheel_directory: str, config_settings: dict | None = None, metadata_directory: str | None = None
+) -> str:
     name = _setuptools.build_wheel(wheel_directory, config_settings, metadata_directory)
     with tempfile.TemporaryDirectory(prefix="labware_interfaces_") as scratch:
         installed = _build_interfaces(Path(scratch))
@@ -52,11 +56,12 @@ def build_wheel(wheel_directory: str, config_settings: dict | None = None, metad
 
 def _ros_prefix() -> Path:
     """The prefix the ROS build packages were installed under (their share/ and lib/)."""
-    for file in metadata.distribution("ros-jazzy-ament-cmake").files or []:
-        if str(file).endswith("ament_cmakeConfig.cmake"):
-            located = Path(file.locate()).resolve()
-            return located.parents[3]  # <prefix>/share/ament_cmake/cmake/ament_cmakeConfig.cmake
-    raise RuntimeError("ros-jazzy-ament-cmake is installed without its CMake files")
+    for distribution in metadata.distributions():
+        for file in distribution.files or []:
+            if str(file).endswith("share/ament_cmake_core/cmake/ament_cmake_coreConfig.cmake"):
+                located = Path(str(file.locate())).resolve()
+                return located.parents[3]  # <prefix>/share/ament_cmake_core/cmake/<file>
+    raise RuntimeError("no installed ROS package carries ament_cmake_core's CMake files")
 
 
 def _fix_cmake_paths(prefix: Path) -> None:
@@ -95,7 +100,8 @@ def _build_interfaces(scratch: Path) -> Path:
     build, install = scratch / "build", scratch / "install"
     environment = dict(os.environ)
     environment["PATH"] = os.pathsep.join([str(Path(sys.executable).parent), environment.get("PATH", "")])
-    environment["LD_LIBRARY_PATH"] = os.pathsep.join([str(prefix / "lib"), environment.get("LD_LIBRARY_PATH", "")])
+    library_path = [str(prefix / "lib"), environment.get("LD_LIBRARY_PATH", "")]
+    environment["LD_LIBRARY_PATH"] = os.pathsep.join(library_path)
     environment["AMENT_PREFIX_PATH"] = str(prefix)
     cmake = _cmake()
     steps = [
