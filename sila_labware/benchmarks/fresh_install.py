@@ -54,7 +54,7 @@ def main(argv: list[str] | None = None) -> int:
         )
         verdict = json.loads(demo.stdout.strip().splitlines()[-1]) if demo.stdout.strip() else {}
         figures = {
-            "python": subprocess.run([args.python, "--version"], capture_output=True, text=True).stdout.strip(),
+            "python": subprocess.run([args.python, "-V"], capture_output=True, text=True).stdout.strip(),
             "venv_s": round(venv_s, 1),
             "pip_install_s": round(install_s, 1),
             "interface_build_s": float(build.group(1)) if build else None,
