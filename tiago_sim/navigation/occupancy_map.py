@@ -93,9 +93,13 @@ def station_footprints(world: World) -> list[Footprint]:
     ]
 
 
+def obstacle_footprints(world: World) -> list[Footprint]:
+    """Every free-standing obstacle's outline (boxes and cylinders of the world file)."""
+    return [Footprint(o.x, o.y, o.yaw, o.length, o.width, o.radius) for o in world.obstacles]
+
+
 def build_map(world: World, resolution: float = DEFAULT_RESOLUTION) -> OccupancyMap:
-    """The static map: the floor's edge walls and every bench (and, once the world file has them,
-    its free-standing obstacles: add their outlines to ``station_footprints``' list)."""
+    """The static map: the floor's edge walls, every bench and every free-standing obstacle."""
     half = world.floor_size / 2
     cells = math.ceil(world.floor_size / resolution)
     empty = OccupancyMap(resolution, (-half, -half), np.zeros((cells, cells), dtype=bool))
@@ -104,7 +108,7 @@ def build_map(world: World, resolution: float = DEFAULT_RESOLUTION) -> Occupancy
     grid[:wall_cells, :] = grid[-wall_cells:, :] = True
     grid[:, :wall_cells] = grid[:, -wall_cells:] = True
     walled = OccupancyMap(resolution, empty.origin, grid)
-    return walled.with_footprints(station_footprints(world))
+    return walled.with_footprints(station_footprints(world) + obstacle_footprints(world))
 
 
 def _draw(grid: np.ndarray, grid_map: OccupancyMap, footprint: Footprint) -> None:
