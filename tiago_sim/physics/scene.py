@@ -20,7 +20,7 @@ from labware_model.holders import HotelSlot, Nest
 from labware_model.labware import LabwareType
 from tiago_sim import transforms as tf
 from tiago_sim.lab.world import Obstacle, Station, World
-from tiago_sim.navigation.occupancy_map import WALL_THICKNESS
+from tiago_sim.navigation.occupancy_map import DOCK_GAP, DOCK_SIZE, WALL_THICKNESS
 from tiago_sim.perception.marker_asset import marker_visual
 from tiago_sim.robot.hotel_model import corner_ramp_boxes
 from tiago_sim.robot.robot_model import BASE_RADIUS
@@ -35,8 +35,6 @@ NEST_RAMP_FOOT = 0.001  # the ramp runs on this far below the bench top: no edge
 NEST_LEG_LENGTH = 0.015  # bracket legs run this far in from each corner
 NEST_FRICTION = 0.15  # polished lead-ins: with the plate's 1.0, the pair's friction is 0.15
 TABLE_FRICTION = 0.3  # laminate bench top: plate on table 0.3
-DOCK_GAP = 0.002  # between the docked robot's rear and the dock's contact plate
-DOCK_SIZE = (0.10, 0.45, 0.30)
 WALL_HEIGHT = 1.0  # m: the floor's edge walls (the map's walls; the base laser sees them)
 
 

@@ -1,0 +1,277 @@
+"""Global path planning on the occupancy map: A* on the inflated grid, then straight segments.
+
+Why this shape: the robot turns in place at every corner of its path, and there the onboard hotel
+tray sweeps a circle of ``ROBOT_RADIUS_M`` (its farthest corner from the base centre; the base
+itself is 0.265 m). So the planning map is the static map inflated by that radius plus a margin:
+a cell free there is a cell where the robot may stand and turn. A* (8-connected, octile heuristic)
+runs on it with a cost that grows near the inflated zone, so paths keep away from benches where
+the room allows; the cell path is then cut to the fewest straight segments whose line of sight
+stays clear of a wider comfort zone (or, in a narrow passage, of the inflated map).
+
+Start and goal often lie inside the inflated zone (a POI is 0.6 m from its bench, the working pose
+0.38 m): the robot may leave the zone only along one straight segment from the start and enter it
+only along one straight segment to the goal. That segment is checked against the map inflated by
+the base's own radius (the robot drives it without turning); where the tray could not sweep at the
+start or goal (clearance below ``ROBOT_RADIUS_M``), the segment must also lie along the robot's
+heading there (driven forward or in reverse), so nothing turns where the tray would touch.
+
+Pure (numpy and OpenCV only); any thread. Units: metres, radians.
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from tiago_sim.navigation.occupancy_map import OccupancyMap
+from tiago_sim.robot.hotel_model import HOTEL_POCKET_SIZE, HOTEL_SLOT_XYZ
+from tiago_sim.robot.robot_model import BASE_RADIUS
+
+
+def hotel_sweep_radius() -> float:
+    """The hotel tray's farthest corner from the base centre (the tray plate is the pocket plus
+    3 cm along x and 2 cm across, hotel_model.add_hotel): 0.354 m."""
+    length, width = HOTEL_POCKET_SIZE
+    return max(
+        math.hypot(abs(x) + (length + 0.03) / 2, abs(y) + (width + 0.02) / 2) for x, y, _ in HOTEL_SLOT_XYZ
+    )
+
+
+ROBOT_RADIUS_M = max(BASE_RADIUS, hotel_sweep_radius())
+"""The circle the robot sweeps when it turns in place (the hotel tray's corner, 0.354 m)."""
+INFLATION_MARGIN_M = 0.05
+"""Beyond the sweep: the localisation and path-following error the robot may carry (about 3 cm at
+the end of a drive) plus 2 cm."""
+INFLATION_RADIUS_M = ROBOT_RADIUS_M + INFLATION_MARGIN_M
+FOOTPRINT_MARGIN_M = 0.03
+"""Around the base's own radius on the straight segment leaving or entering the inflated zone."""
+COMFORT_M = 0.15
+"""Straight segments keep this much more than the inflation from obstacles where the room allows."""
+COST_RANGE_M = 0.40
+"""Within this distance of the inflated zone a cell costs more (up to 1 + COST_WEIGHT)."""
+COST_WEIGHT = 3.0
+ALONG_HEADING_RAD = 0.05
+"""A start or goal segment counts as along the heading within this (the drive's own tolerance)."""
+ESCAPE_DIRECTIONS = 72
+ESCAPE_MAX_M = 1.5
+
+
+class PlanningError(Exception):
+    """No path: ``reason`` says why in words ("the goal (1.20, 3.40) is inside an obstacle")."""
+
+    def __init__(self, reason: str) -> None:
+        super().__init__(reason)
+        self.reason = reason
+
+
+@dataclass(frozen=True)
+class Plan:
+    """Waypoints (x, y) from the start to the goal; ``reverse_first`` / ``reverse_last``: that
+    segment is driven backwards (it leaves or enters the inflated zone along the robot's heading)."""
+
+    waypoints: tuple[tuple[float, float], ...]
+    reverse_first: bool = False
+    reverse_last: bool = False
+    planning_s: float = 0.0
+
+    @property
+    def length_m(self) -> float:
+        return sum(math.dist(a, b) for a, b in zip(self.waypoints, self.waypoints[1:], strict=False))
+
+
+class GlobalPlanner:
+    """Plans on one static map; build once per map (the inflation and cost grids are cached)."""
+
+    def __init__(self, static_map: OccupancyMap) -> None:
+        self.static_map = static_map
+        clearance = static_map.clearance_m()
+        self.clearance = clearance
+        self.inflated = static_map.inflated(INFLATION_RADIUS_M)
+        self.comfort = static_map.inflated(INFLATION_RADIUS_M + COMFORT_M)
+        self.footprint = static_map.inflated(BASE_RADIUS + FOOTPRINT_MARGIN_M)
+        beyond = np.clip((clearance - INFLATION_RADIUS_M) / COST_RANGE_M, 0.0, 1.0)
+        cost = 1.0 + COST_WEIGHT * (1.0 - beyond)
+        cost[self.inflated.occupied] = math.inf
+        self._cost = cost.ravel().tolist()
+        self._cols = static_map.shape[1]
+
+    # -- the public call ------------------------------------------------------------------
+    def plan(self, start: tuple[float, float, float], goal: tuple[float, float, float]) -> Plan:
+        """A path from the start pose (x, y, yaw) to the goal pose; raises PlanningError."""
+        started = time.perf_counter()
+        grid = self.static_map
+        for what, (x, y, _) in (("goal", goal), ("start", start)):
+            if not grid.is_free(x, y) or not self.footprint.is_free(x, y):
+                raise PlanningError(
+                    f"the {what} ({x:.2f}, {y:.2f}) is inside an obstacle or closer than "
+                    f"{BASE_RADIUS + FOOTPRINT_MARGIN_M:.2f} m to one"
+                )
+        if self._segment_free(self.footprint, start[:2], goal[:2]) and self.inflated.is_free(*start[:2]):
+            if self.inflated.is_free(*goal[:2]) and self._segment_free(self.inflated, start[:2], goal[:2]):
+                return Plan((start[:2], goal[:2]), planning_s=time.perf_counter() - started)
+        exit_point, reverse_first = self._edge_point(start, leaving=True)
+        entry_point, reverse_last = self._edge_point(goal, leaving=False)
+        cells = self._astar(grid.cell_of(*exit_point), grid.cell_of(*entry_point))
+        if cells is None:
+            raise PlanningError(
+                f"no path from ({start[0]:.2f}, {start[1]:.2f}) to ({goal[0]:.2f}, {goal[1]:.2f}) "
+                f"with {INFLATION_RADIUS_M:.2f} m clearance (the robot's turning circle plus margin)"
+            )
+        middle = self._shortcut([grid.centre_of(*cell) for cell in cells])
+        points = [start[:2]]
+        points += [p for p in (exit_point, *middle[1:-1], entry_point) if math.dist(p, points[-1]) > 1e-3]
+        if math.dist(goal[:2], points[-1]) > 1e-3:
+            points.append(goal[:2])
+        points = self._shortcut_ends(points)
+        waypoints = tuple((float(x), float(y)) for x, y in points)
+        return Plan(waypoints, reverse_first, reverse_last, time.perf_counter() - started)
+
+    # -- start and goal inside the inflated zone ------------------------------------------
+    def _edge_point(
+        self, pose: tuple[float, float, float], *, leaving: bool
+    ) -> tuple[tuple[float, float], bool]:
+        """The pose itself if the robot may turn there; else the nearest point free in the inflated
+        map along one straight segment clear for the base (along its heading where the tray cannot
+        sweep). Returns the point and whether that segment is driven in reverse."""
+        x, y, yaw = pose
+        if self.inflated.is_free(x, y):
+            return (x, y), False
+        row, col = self.static_map.cell_of(x, y)
+        may_turn = self.clearance[row, col] >= ROBOT_RADIUS_M
+        if may_turn:
+            directions = [2 * math.pi * k / ESCAPE_DIRECTIONS for k in range(ESCAPE_DIRECTIONS)]
+        else:  # leaving: drive along the heading; entering: arrive along the goal heading
+            directions = [yaw, yaw + math.pi]
+        best: tuple[float, tuple[float, float], bool] | None = None
+        step = self.static_map.resolution / 2
+        for direction in directions:
+            dx, dy = math.cos(direction), math.sin(direction)
+            distance = step
+            while distance <= ESCAPE_MAX_M:
+                point = (x + dx * distance, y + dy * distance)
+                if not self.footprint.is_free(*point):
+                    break
+                if self.inflated.is_free(*point):
+                    if best is None or distance < best[0]:
+                        ahead = math.cos(direction - yaw) > 0.0
+                        # where it cannot turn, leaving backwards or arriving from ahead of the goal
+                        # runs the segment in reverse
+                        reverse = not may_turn and (not ahead if leaving else ahead)
+                        best = (distance, point, reverse)
+                    break
+                distance += step
+        if best is None:
+            what = "start" if leaving else "goal"
+            rule = "in any direction" if may_turn else "along its heading (the tray cannot turn there)"
+            raise PlanningError(
+                f"the {what} ({x:.2f}, {y:.2f}) is {self.clearance[row, col]:.2f} m from an obstacle and "
+                f"no straight segment {rule} reaches {INFLATION_RADIUS_M:.2f} m clearance "
+                f"within {ESCAPE_MAX_M} m"
+            )
+        return best[1], best[2]
+
+    # -- the grid search ------------------------------------------------------------------
+    def _astar(self, start: tuple[int, int], goal: tuple[int, int]) -> list[tuple[int, int]] | None:
+        cols = self._cols
+        cost = self._cost
+        rows = len(cost) // cols
+        if not (
+            0 <= start[0] < rows and 0 <= goal[0] < rows and 0 <= start[1] < cols and 0 <= goal[1] < cols
+        ):
+            return None
+        begin, end = start[0] * cols + start[1], goal[0] * cols + goal[1]
+        if math.isinf(cost[begin]) or math.isinf(cost[end]):
+            return None
+        goal_row, goal_col = goal
+        diagonal = math.sqrt(2.0)
+        steps = [(-1, 0, 1.0), (1, 0, 1.0), (0, -1, 1.0), (0, 1, 1.0)]
+        steps += [(-1, -1, diagonal), (-1, 1, diagonal), (1, -1, diagonal), (1, 1, diagonal)]
+        moves = [(dr * cols + dc, dr, dc, length) for dr, dc, length in steps]
+        best = {begin: 0.0}
+        came_from = {begin: -1}
+        frontier = [(0.0, begin)]
+        closed = set()
+        while frontier:
+            _, current = heapq.heappop(frontier)
+            if current == end:
+                break
+            if current in closed:
+                continue
+            closed.add(current)
+            row, col = divmod(current, cols)
+            here = best[current]
+            for offset, dr, dc, length in moves:
+                r, c = row + dr, col + dc
+                if r < 0 or r >= rows or c < 0 or c >= cols:
+                    continue
+                neighbour = current + offset
+                step_cost = cost[neighbour]
+                if step_cost == math.inf:
+                    continue
+                total = here + length * 0.5 * (step_cost + cost[current])
+                if total < best.get(neighbour, math.inf):
+                    best[neighbour] = total
+                    came_from[neighbour] = current
+                    ar, ac = abs(goal_row - r), abs(goal_col - c)
+                    heuristic = max(ar, ac) + (diagonal - 1.0) * min(ar, ac)
+                    heapq.heappush(frontier, (total + heuristic, neighbour))
+        if end not in came_from:
+            return None
+        cells = []
+        node = end
+        while node != -1:
+            cells.append(divmod(node, cols))
+            node = came_from[node]
+        return cells[::-1]
+
+    # -- straight segments ----------------------------------------------------------------
+    def _segment_free(self, grid: OccupancyMap, a: tuple[float, float], b: tuple[float, float]) -> bool:
+        """Every point of the segment lies in a free cell (sampled at a quarter cell)."""
+        samples = max(2, int(math.dist(a, b) / (grid.resolution / 4)) + 1)
+        t = np.linspace(0.0, 1.0, samples)
+        xs = a[0] + (b[0] - a[0]) * t
+        ys = a[1] + (b[1] - a[1]) * t
+        rows = np.floor((ys - grid.origin[1]) / grid.resolution).astype(int)
+        cols = np.floor((xs - grid.origin[0]) / grid.resolution).astype(int)
+        height, width = grid.shape
+        if rows.min() < 0 or cols.min() < 0 or rows.max() >= height or cols.max() >= width:
+            return False
+        return not bool(grid.occupied[rows, cols].any())
+
+    def _shortcut(self, points: list[tuple[float, float]]) -> list[tuple[float, float]]:
+        """Greedy line of sight: from each kept point, on to the farthest one in sight (comfort
+        zone first; the inflated map where the path itself runs closer)."""
+        kept = [points[0]]
+        i = 0
+        while i < len(points) - 1:
+            j = self._farthest_in_sight(points, i, self.comfort)
+            if j == i + 1:
+                j = self._farthest_in_sight(points, i, self.inflated)
+            kept.append(points[j])
+            i = j
+        return kept
+
+    def _farthest_in_sight(self, points: list[tuple[float, float]], i: int, grid: OccupancyMap) -> int:
+        for j in range(len(points) - 1, i + 1, -1):
+            if self._segment_free(grid, points[i], points[j]):
+                return j
+        return i + 1
+
+    def _shortcut_ends(self, points: list[tuple[float, float]]) -> list[tuple[float, float]]:
+        """Drop a waypoint next to the start or goal where the straight line skips it safely
+        (both ends must stay where the robot may turn)."""
+        changed = True
+        while changed and len(points) > 2:
+            changed = False
+            for index in range(1, len(points) - 1):
+                before, after = points[index - 1], points[index + 1]
+                ends_ok = self.inflated.is_free(*before) and self.inflated.is_free(*after)
+                if ends_ok and self._segment_free(self.inflated, before, after):
+                    del points[index]
+                    changed = True
+                    break
+        return points
