@@ -47,6 +47,7 @@ class Scene:
     tables: dict[str, int] = field(default_factory=dict)
     nests: dict[Nest, int] = field(default_factory=dict)
     markers: dict[str, int] = field(default_factory=dict)
+    marker_stands: dict[str, int] = field(default_factory=dict)
     obstacles: dict[str, int] = field(default_factory=dict)
     walls: dict[str, int] = field(default_factory=dict)
     plates: dict[str, int] = field(default_factory=dict)
@@ -121,7 +122,9 @@ def _build_station(client: int, station: Station, labware: LabwareType, scene: S
     board = station.marker_size * 1.4
     stand_height = station.marker_xyz[2] + board / 2
     T_world_board = T_world_marker @ tf.make_transform((0, stand_height / 2 - station.marker_xyz[2], -0.006))
-    _static_box(client, (board, stand_height, 0.01), T_world_board, [0.95, 0.95, 0.95, 1])
+    scene.marker_stands[station.name] = _static_box(
+        client, (board, stand_height, 0.01), T_world_board, [0.95, 0.95, 0.95, 1]
+    )
     T_world_tile = T_world_marker @ tf.make_transform((0, 0, 0.0008))
     scene.markers[station.name] = marker_visual(client, station.marker_id, station.marker_size, T_world_tile)
     pocket = (labware.length + 2 * station.nest_clearance, labware.width + 2 * station.nest_clearance)

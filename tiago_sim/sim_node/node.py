@@ -43,6 +43,7 @@ from tiago_sim.robot.motion_library import DEFAULT_MOTIONS_FILE, load_motions
 from tiago_sim.sim_node.action_servers import RobotActionServers
 from tiago_sim.sim_node.behaviours import RobotBehaviours
 from tiago_sim.sim_node.marker_motion import MarkerMotionBehaviour
+from tiago_sim.sim_node.navigation import Navigation
 from tiago_sim.sim_node.publishers import StatePublishers
 from tiago_sim.sim_node.sim_thread import SimThread
 
@@ -71,6 +72,7 @@ class SimNode:
             hotel_slots=world.hotel_slots,
             motions=motions,
             speed_scale=lambda: float(node.get_parameter("speed_scale").value),
+            navigation=Navigation(node, world),
         )
         self.marker_motion = MarkerMotionBehaviour(world, self.behaviours, motions.hotel)
         self.actions = RobotActionServers(
