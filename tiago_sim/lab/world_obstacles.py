@@ -11,10 +11,10 @@ import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 
-KEEP_CLEAR_M = 0.40
-"""Free radius (m) around every POI, the docked pose and the working poses: the onboard hotel tray
-sweeps 0.35 m from the base centre when the robot turns there (world_picture.HOTEL_SWEEP_RADIUS_M),
-plus 5 cm."""
+KEEP_CLEAR_M = 0.55
+"""Free radius (m) around every POI, the docked pose and the working poses: the robot turns there,
+and its folded arms sweep 0.48 m from the base centre (navigation.planner.ARM_SWEEP_RADIUS_M;
+the hotel tray 0.354 m), plus 7 cm."""
 DOCK_PATH_SAMPLES = 5
 
 
@@ -132,7 +132,7 @@ def placement_problems(
                     (
                         f"{where}.pose",
                         f"{obstacle.name!r} is {distance:.2f} m from {what} at ({px:.2f}, {py:.2f}); "
-                        f"keep {KEEP_CLEAR_M:.2f} m free there (the hotel tray's sweep when the robot turns)",
+                        f"keep {KEEP_CLEAR_M:.2f} m free there (the robot's sweep when it turns)",
                     )
                 )
     return problems

@@ -24,8 +24,10 @@ from tiago_sim.lab.world import Pose2D, Station, World
 
 BASE_RADIUS_M = 0.265
 """TIAGo's base (tiago_sim.robot.robot_model.BASE_RADIUS; the lab layer does not import the robot)."""
-HOTEL_SWEEP_RADIUS_M = 0.35
-"""The onboard hotel tray's farthest corner from the base centre: the circle it sweeps in a turn."""
+HOTEL_SWEEP_RADIUS_M = 0.48
+"""The robot's farthest point from the base centre in the travel pose: the folded arms
+(navigation.planner.ARM_SWEEP_RADIUS_M; the hotel tray's corner is at 0.354 m): the circle it
+sweeps in a turn."""
 ARROW_M = 0.35
 PLATE_COLOURS = ("tab:orange", "tab:purple", "tab:cyan", "tab:olive", "tab:pink")
 
@@ -145,7 +147,7 @@ def draw_world(world: World, path: Path) -> None:
     ax.text(0.01, 0.99, "\n".join(notes), transform=ax.transAxes, fontsize=8, va="top", bbox={"fc": "white"})
     ax.set_title(
         f"{world.name} ({Path(world.source).name}), floor {world.floor_size:g} m\n"
-        "base footprint (filled) and hotel sweep (dashed) at each POI; dotted: working pose",
+        "base footprint (filled) and turning sweep (dashed) at each POI; dotted: working pose",
         fontsize=9,
     )
     low, high = _extent(world)

@@ -1,19 +1,20 @@
 """Global path planning on the occupancy map: A* on the inflated grid, then straight segments.
 
-Why this shape: the robot turns in place at every corner of its path, and there the onboard hotel
-tray sweeps a circle of ``ROBOT_RADIUS_M`` (its farthest corner from the base centre; the base
-itself is 0.265 m). So the planning map is the static map inflated by that radius plus a margin:
-a cell free there is a cell where the robot may stand and turn. A* (8-connected, octile heuristic)
+Why this shape: the robot turns in place at every corner of its path, and there it sweeps a circle
+of ``ROBOT_RADIUS_M``: the folded arms (Home/Tuck) reach 0.48 m sideways from the base centre, the
+onboard hotel tray's corner 0.354 m ahead, the base itself 0.265 m. So the planning map is the
+static map inflated by that radius plus a margin: a cell free there is a cell where the robot may
+stand and turn. A* (8-connected, octile heuristic)
 runs on it with a cost that grows near the inflated zone, so paths keep away from benches where
 the room allows; the cell path is then cut to the fewest straight segments whose line of sight
 stays clear of a wider comfort zone (or, in a narrow passage, of the inflated map).
 
-Start and goal often lie inside the inflated zone (a POI is 0.6 m from its bench, the working pose
+Start and goal may lie inside the inflated zone (a POI is 0.6 m from its bench, the working pose
 0.38 m): the robot may leave the zone only along one straight segment from the start and enter it
 only along one straight segment to the goal. That segment is checked against the map inflated by
 the base's own radius (the robot drives it without turning); where the tray could not sweep at the
 start or goal (clearance below ``ROBOT_RADIUS_M``), the segment must also lie along the robot's
-heading there (driven forward or in reverse), so nothing turns where the tray would touch.
+heading there (driven forward or in reverse), so nothing turns where the arms or tray would touch.
 
 Pure (numpy and OpenCV only); any thread. Units: metres, radians.
 """
@@ -41,8 +42,14 @@ def hotel_sweep_radius() -> float:
     )
 
 
-ROBOT_RADIUS_M = max(BASE_RADIUS, hotel_sweep_radius())
-"""The circle the robot sweeps when it turns in place (the hotel tray's corner, 0.354 m)."""
+ARM_SWEEP_RADIUS_M = 0.48
+"""The folded arms' farthest point from the base centre in the travel pose (Home/Tuck, torso at
+0.15 m): arm_*_4_link at 0.479 m, sideways, from 0.74 m above the floor up, so over a bench top too
+(tests/tiago_sim/physics/test_sim_collisions.py probes it in PyBullet; an arm grazed bench_c's top
+when the robot drove straight at it)."""
+ROBOT_RADIUS_M = max(BASE_RADIUS, hotel_sweep_radius(), ARM_SWEEP_RADIUS_M)
+"""The circle the robot sweeps when it turns in place (the arms', 0.48 m; the tray's corner is at
+0.354 m)."""
 INFLATION_MARGIN_M = 0.05
 """Beyond the sweep: the localisation and path-following error the robot may carry (about 3 cm at
 the end of a drive) plus 2 cm."""
@@ -166,7 +173,7 @@ class GlobalPlanner:
                 distance += step
         if best is None:
             what = "start" if leaving else "goal"
-            rule = "in any direction" if may_turn else "along its heading (the tray cannot turn there)"
+            rule = "in any direction" if may_turn else "along its heading (it cannot turn there)"
             raise PlanningError(
                 f"the {what} ({x:.2f}, {y:.2f}) is {self.clearance[row, col]:.2f} m from an obstacle and "
                 f"no straight segment {rule} reaches {INFLATION_RADIUS_M:.2f} m clearance "

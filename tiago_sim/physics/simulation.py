@@ -153,8 +153,10 @@ class Simulation:
             self.motions = [m for m in motions if not m.done]
 
     def _stop_on_collision(self) -> None:
-        """An unintended contact (collision_watch) fails every running motion, naming it."""
+        """An unintended contact (collision_watch) stops the base at once and fails every running
+        motion, naming it."""
         for collision in self.collision_watch.check(self.sim_time):
+            self.base.protective_stop()
             for motion in self.motions:
                 motion.finish(False, COLLISION, collision.text())
 

@@ -12,10 +12,12 @@ from tiago_sim.lab.world import DEFAULT_WORLD, load_world
 from tiago_sim.navigation.occupancy_map import Footprint, OccupancyMap, build_map
 from tiago_sim.navigation.plan_benchmark import measure
 from tiago_sim.navigation.planner import (
+    ARM_SWEEP_RADIUS_M,
     INFLATION_RADIUS_M,
     ROBOT_RADIUS_M,
     GlobalPlanner,
     PlanningError,
+    hotel_sweep_radius,
 )
 
 BENCH_IN_THE_WAY = DEFAULT_WORLD.parent / "bench_in_the_way.yaml"
@@ -40,9 +42,10 @@ def clearance_along(planner: GlobalPlanner, waypoints: tuple[tuple[float, float]
     return least
 
 
-def test_the_tray_sweep_sets_the_inflation() -> None:
+def test_the_folded_arms_and_the_tray_set_the_inflation() -> None:
     # the tray plate's far corner: x 0.25 + (0.1318 + 0.03) / 2, y 0.07 + (0.0895 + 0.02) / 2
-    assert ROBOT_RADIUS_M == pytest.approx(math.hypot(0.3309, 0.12475), abs=1e-3)
+    assert hotel_sweep_radius() == pytest.approx(math.hypot(0.3309, 0.12475), abs=1e-3)
+    assert ROBOT_RADIUS_M == ARM_SWEEP_RADIUS_M > hotel_sweep_radius()  # the arms reach farther
     assert INFLATION_RADIUS_M == pytest.approx(ROBOT_RADIUS_M + 0.05)
 
 
