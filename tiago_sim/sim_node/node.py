@@ -6,8 +6,8 @@
 Threads: the sim thread (sim_thread.SimThread) owns the Simulation and steps it; a
 MultiThreadedExecutor spins the node on the main thread; action execute callbacks and timers only
 hand jobs to the sim thread and wait on futures. Offers the robot-level actions (ros_actions),
-the sensor topics (ros_publishers), /describe_workcell and /check_placement (ground truth, for
-success checks only).
+the sensor topics (ros_publishers), /map, /global_costmap/costmap and /plan (navigation),
+/describe_workcell and /check_placement (ground truth, for success checks only).
 
 ROS parameters (changeable at runtime): ``pois.<name>`` = [x, y, yaw] (from the world YAML),
 ``stations.<name>.approach_height_m``, ``speed_scale``, ``realtime_factor_cap`` (0 = none),
@@ -25,6 +25,7 @@ import argparse
 import dataclasses
 import logging
 import sys
+from array import array
 from pathlib import Path
 from typing import Any
 
@@ -109,7 +110,8 @@ class SimNode:
     def _on_parameters(self, parameters: list[Parameter]) -> SetParametersResult:
         for parameter in parameters:
             name, value = parameter.name, parameter.value
-            if name.startswith("pois.") and (not isinstance(value, (list, tuple)) or len(value) != 3):
+            # a double array arrives over ROS as array.array, from a launch file as a list
+            if name.startswith("pois.") and (not isinstance(value, (list, tuple, array)) or len(value) != 3):
                 return SetParametersResult(successful=False, reason=f"{name} must be [x, y, yaw]")
             if name == "speed_scale" and not 0.05 <= float(value) <= 2.0:
                 return SetParametersResult(successful=False, reason="speed_scale must be in 0.05 .. 2.0")
