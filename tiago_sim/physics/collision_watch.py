@@ -31,6 +31,15 @@ TOUCH_DISTANCE_M = 0.0
 reports points up to its contact-breaking threshold (2 cm) apart, which are not touches."""
 DOCK_LINKS = frozenset({"base_footprint", "base_link"})
 """The robot links that touch the dock by design."""
+NEAR_MISS_M = 0.01
+"""Closer than this without touching is a near miss: logged (INFO) with the closest approach per
+link and thing, so a run's log says how much room the arm and base really had. Bullet's contact
+points hold touching pairs only, so near misses come from closest-point queries, every
+NEAR_MISS_PERIOD_S of sim time (the arm moves at most 1.5 cm in it near a bench)."""
+NEAR_MISS_PERIOD_S = 0.02
+REACH_M = 1.2
+"""Only things whose box lies within this of the base centre are queried for near misses (the arm
+reaches about 0.9 m): a closest-point query against all ~15 things cost 0.2 ms, half a step."""
 BASE_TOP_M = 0.30
 """PyBullet merges the fixed base, its cover and the hotel tray into one link (base_footprint);
 a contact above the base's top (0.297 m) is the hotel tray's (or its post's)."""
@@ -76,6 +85,26 @@ class CollisionWatch:
         self.link_names = {index: name for name, index in robot.link_index.items()}
         self.touching: set[tuple[int, int]] = set()  # (link index, body) touching after the last step
         self.collisions: list[Collision] = []
+        self.near_misses: dict[tuple[str, str], float] = {}  # (link, thing) -> closest approach (m)
+        self._reviewed_at = -1.0
+        self._boxes = {body: p.getAABB(body, physicsClientId=client) for body in self.things}
+
+    def _review_near_misses(self) -> None:
+        x, y, _ = self.robot.base_xy_yaw()
+        for body, thing in self.things.items():
+            (low_x, low_y, _), (high_x, high_y, _) = self._boxes[body]
+            if max(low_x - x, x - high_x, low_y - y, y - high_y) > REACH_M:
+                continue
+            for point in p.getClosestPoints(self.robot.id, body, NEAR_MISS_M, physicsClientId=self.client):
+                link, distance = point[3], point[8]
+                if distance <= TOUCH_DISTANCE_M or (
+                    body == self.dock and self.link_names.get(link) in DOCK_LINKS
+                ):
+                    continue
+                key = (self._link_name(link, point[5]), thing)
+                if distance < self.near_misses.get(key, NEAR_MISS_M) - 0.001:  # a new closest, by 1 mm
+                    self.near_misses[key] = distance
+                    log.info("near miss: %s came within %.1f mm of %s", key[0], distance * 1000, thing)
 
     def _link_name(self, link: int, position: tuple[float, float, float]) -> str:
         name = self.link_names.get(link, f"link {link}")
@@ -90,9 +119,9 @@ class CollisionWatch:
         deepest: dict[tuple[int, int], tuple[float, tuple[float, float, float]]] = {}
         for point in p.getContactPoints(bodyA=self.robot.id, physicsClientId=self.client):
             body, link, distance = point[2], point[3], point[8]
-            if body not in self.things or distance > TOUCH_DISTANCE_M:
+            if body not in self.things or (body == self.dock and self.link_names.get(link, "") in DOCK_LINKS):
                 continue
-            if body == self.dock and self.link_names.get(link, "") in DOCK_LINKS:
+            if distance > TOUCH_DISTANCE_M:
                 continue
             key = (link, body)
             if key not in deepest or -distance > deepest[key][0]:
@@ -103,6 +132,9 @@ class CollisionWatch:
             if (link, body) not in self.touching
         ]
         self.touching = set(deepest)
+        if sim_time - self._reviewed_at >= NEAR_MISS_PERIOD_S:
+            self._reviewed_at = sim_time
+            self._review_near_misses()
         for collision in started:
             log.warning("collision: %s", collision.text())
         self.collisions.extend(started)
