@@ -63,8 +63,31 @@ COST_RANGE_M = 0.40
 COST_WEIGHT = 3.0
 ALONG_HEADING_RAD = 0.05
 """A start or goal segment counts as along the heading within this (the drive's own tolerance)."""
+HEURISTIC_WEIGHT = 1.5
+"""A* with its heuristic weighted (the octile distance times this): paths at most 1.5 times the
+cheapest, found with far fewer expansions; the line-of-sight pass straightens them anyway.
+Unweighted, a detour took 12.6 ms median on an idle core, and four times that on a loaded one."""
+SEARCH_CELLS = 2
+"""A* searches blocks of 2 x 2 map cells (10 cm): a quarter of the expansions; a block is free
+only where all its cells are, so a corridor loses at most a cell's width (5 cm) to it, and the
+straight segments are then checked on the 5 cm map."""
 ESCAPE_DIRECTIONS = 72
 ESCAPE_MAX_M = 1.5
+
+
+def _coarsened(grid: OccupancyMap, cost: np.ndarray, factor: int) -> tuple[OccupancyMap, np.ndarray]:
+    """A grid of `factor` x `factor` blocks: a block is occupied if any of its cells is, and costs
+    what its dearest cell does (the edge beyond the map counts as occupied)."""
+    rows, cols = grid.shape
+    padded_rows, padded_cols = -(-rows // factor) * factor, -(-cols // factor) * factor
+    occupied = np.ones((padded_rows, padded_cols), dtype=bool)
+    occupied[:rows, :cols] = grid.occupied
+    padded_cost = np.full((padded_rows, padded_cols), math.inf)
+    padded_cost[:rows, :cols] = cost
+    shape = (padded_rows // factor, factor, padded_cols // factor, factor)
+    blocks = occupied.reshape(shape).any(axis=(1, 3))
+    block_cost = padded_cost.reshape(shape).max(axis=(1, 3))
+    return OccupancyMap(grid.resolution * factor, grid.origin, blocks), block_cost
 
 
 class PlanningError(Exception):
@@ -103,8 +126,9 @@ class GlobalPlanner:
         beyond = np.clip((clearance - INFLATION_RADIUS_M) / COST_RANGE_M, 0.0, 1.0)
         cost = 1.0 + COST_WEIGHT * (1.0 - beyond)
         cost[self.inflated.occupied] = math.inf
-        self._cost = cost.ravel().tolist()
-        self._cols = static_map.shape[1]
+        self.search_grid, search_cost = _coarsened(self.inflated, cost, SEARCH_CELLS)
+        self._cost = search_cost.ravel().tolist()
+        self._cols = self.search_grid.shape[1]
 
     # -- the public call ------------------------------------------------------------------
     def plan(self, start: tuple[float, float, float], goal: tuple[float, float, float]) -> Plan:
@@ -122,15 +146,17 @@ class GlobalPlanner:
                 return Plan((start[:2], goal[:2]), planning_s=time.perf_counter() - started)
         exit_point, reverse_first = self._edge_point(start, leaving=True)
         entry_point, reverse_last = self._edge_point(goal, leaving=False)
-        cells = self._astar(grid.cell_of(*exit_point), grid.cell_of(*entry_point))
+        first, last = self._search_cell_near(exit_point), self._search_cell_near(entry_point)
+        cells = None if first is None or last is None else self._astar(first, last)
         if cells is None:
             raise PlanningError(
                 f"no path from ({start[0]:.2f}, {start[1]:.2f}) to ({goal[0]:.2f}, {goal[1]:.2f}) "
                 f"with {INFLATION_RADIUS_M:.2f} m clearance (the robot's turning circle plus margin)"
             )
-        middle = self._shortcut([grid.centre_of(*cell) for cell in cells])
+        centres = [self.search_grid.centre_of(*cell) for cell in cells]
+        middle = self._shortcut([exit_point, *centres, entry_point])
         points = [start[:2]]
-        points += [p for p in (exit_point, *middle[1:-1], entry_point) if math.dist(p, points[-1]) > 1e-3]
+        points += [p for p in middle if math.dist(p, points[-1]) > 1e-3]
         if math.dist(goal[:2], points[-1]) > 1e-3:
             points.append(goal[:2])
         points = self._shortcut_ends(points)
@@ -182,7 +208,24 @@ class GlobalPlanner:
         return best[1], best[2]
 
     # -- the grid search ------------------------------------------------------------------
+    def _search_cell_near(self, point: tuple[float, float]) -> tuple[int, int] | None:
+        """The search cell holding `point`, or (a search cell is free only where all its map cells
+        are) the nearest free one within two cells whose centre the point sees on the inflated map."""
+        row, col = self.search_grid.cell_of(*point)
+        candidates = sorted(
+            ((row + dr, col + dc) for dr in range(-2, 3) for dc in range(-2, 3)),
+            key=lambda cell: math.dist(point, self.search_grid.centre_of(*cell)),
+        )
+        for cell in candidates:
+            if self.search_grid.inside(*cell) and not self.search_grid.occupied[cell]:
+                if cell == (row, col) or self._segment_free(
+                    self.inflated, point, self.search_grid.centre_of(*cell)
+                ):
+                    return cell
+        return None
+
     def _astar(self, start: tuple[int, int], goal: tuple[int, int]) -> list[tuple[int, int]] | None:
+        """Cells from start to goal on the cost grid (lists, not numpy: scalar access is faster)."""
         cols = self._cols
         cost = self._cost
         rows = len(cost) // cols
@@ -197,36 +240,37 @@ class GlobalPlanner:
         diagonal = math.sqrt(2.0)
         steps = [(-1, 0, 1.0), (1, 0, 1.0), (0, -1, 1.0), (0, 1, 1.0)]
         steps += [(-1, -1, diagonal), (-1, 1, diagonal), (1, -1, diagonal), (1, 1, diagonal)]
-        moves = [(dr * cols + dc, dr, dc, length) for dr, dc, length in steps]
-        best = {begin: 0.0}
-        came_from = {begin: -1}
-        frontier = [(0.0, begin)]
-        closed = set()
+        moves = [(dr * cols + dc, dr, dc, 0.5 * length) for dr, dc, length in steps]
+        best = [math.inf] * len(cost)
+        came_from = [-1] * len(cost)
+        best[begin] = 0.0
+        frontier = [(0.0, 0.0, begin)]
+        weight = HEURISTIC_WEIGHT
+        pop, push, inf = heapq.heappop, heapq.heappush, math.inf
         while frontier:
-            _, current = heapq.heappop(frontier)
+            _, here, current = pop(frontier)
             if current == end:
                 break
-            if current in closed:
-                continue
-            closed.add(current)
+            if here > best[current]:
+                continue  # a stale entry: a cheaper way here was found after it was queued
             row, col = divmod(current, cols)
-            here = best[current]
-            for offset, dr, dc, length in moves:
+            own = cost[current]
+            for offset, dr, dc, half_length in moves:
                 r, c = row + dr, col + dc
                 if r < 0 or r >= rows or c < 0 or c >= cols:
                     continue
                 neighbour = current + offset
                 step_cost = cost[neighbour]
-                if step_cost == math.inf:
+                if step_cost == inf:
                     continue
-                total = here + length * 0.5 * (step_cost + cost[current])
-                if total < best.get(neighbour, math.inf):
+                total = here + half_length * (step_cost + own)
+                if total < best[neighbour]:
                     best[neighbour] = total
                     came_from[neighbour] = current
                     ar, ac = abs(goal_row - r), abs(goal_col - c)
                     heuristic = max(ar, ac) + (diagonal - 1.0) * min(ar, ac)
-                    heapq.heappush(frontier, (total + heuristic, neighbour))
-        if end not in came_from:
+                    push(frontier, (total + weight * heuristic, total, neighbour))
+        if best[end] == inf:
             return None
         cells = []
         node = end
