@@ -223,6 +223,11 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser.add_argument("--disturbance-levels", default="", help="DisturbanceLevels JSON")
     parser.add_argument("--record-dir", type=Path, default=None, help="save camera frames here")
     parser.add_argument("--log-level", default="INFO")
+    parser.add_argument(
+        "--near-misses",
+        action="store_true",
+        help="log robot parts passing within 1 cm of the lab (measuring)",
+    )
     return parser.parse_args(argv)
 
 
@@ -240,6 +245,10 @@ def make_simulation(simulation_class: Any, world: World, args: argparse.Namespac
             odometry_noise=disturbance.levels.odometry_noise,
         )
         disturbances.apply_to_simulation(sim, disturbance)
+    if getattr(args, "near_misses", False):
+        from tiago_sim.physics.collision_watch import NEAR_MISS_PERIOD_S
+
+        sim.collision_watch.near_miss_period_s = NEAR_MISS_PERIOD_S
     if args.record_dir is not None:
         from tiago_sim.measuring.run_recorder import RunRecorder
 

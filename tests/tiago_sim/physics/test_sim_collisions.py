@@ -11,7 +11,7 @@ import pytest
 from tiago_sim.lab.world import DEFAULT_WORLD, load_world
 from tiago_sim.navigation.occupancy_map import build_map
 from tiago_sim.navigation.planner import ROBOT_RADIUS_M, GlobalPlanner
-from tiago_sim.physics.collision_watch import COLLISION
+from tiago_sim.physics.collision_watch import COLLISION, NEAR_MISS_PERIOD_S
 from tiago_sim.physics.simulation import Simulation
 
 WORLD = DEFAULT_WORLD.parent / "bench_in_the_way.yaml"
@@ -91,3 +91,18 @@ def test_the_travel_pose_sweeps_no_farther_than_the_planners_robot_radius() -> N
     assert max(reach) > ROBOT_RADIUS_M - 0.02, (
         f"the planner's radius is {ROBOT_RADIUS_M - max(reach):.3f} m too big"
     )
+
+
+def test_near_misses_when_asked_for_are_recorded_before_the_touch() -> None:
+    world = load_world(WORLD)
+    sim = Simulation(world, seed=5)
+    sim.collision_watch.near_miss_period_s = NEAR_MISS_PERIOD_S
+    planner = GlobalPlanner(build_map(world))
+    assert sim.run(sim.undock()).success
+    go(sim, planner, "station_a_work")
+    goal = world.pois["station_b_work"]
+    motion = sim.run(sim.drive_to(goal.x, goal.y, goal.yaw, speed=0.1))
+    assert motion.error_code == COLLISION
+    closest = sim.collision_watch.near_misses
+    assert any(thing == "obstacle bench_c" and distance < 0.005 for (_, thing), distance in closest.items())
+    sim.close()
