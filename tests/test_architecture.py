@@ -32,6 +32,7 @@ ALLOWED: dict[str, set[str]] = {
         "tiago_sim.lab",
         "tiago_sim.robot",
         "tiago_sim.perception",
+        "tiago_sim.navigation",
     },
     "tiago_sim.measuring": {
         "labware_model",

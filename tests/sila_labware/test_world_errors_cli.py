@@ -62,14 +62,14 @@ def test_serve_refuses_an_invalid_world_in_one_line(
 
 def test_demo_and_world_check_list_every_problem_in_the_same_words(tmp_path: Path) -> None:
     def three_problems(w: dict[str, Any]) -> None:
-        w["obstacles"] = [[1.0, 2.0, 0.5]]  # not part of the schema: refused like any unknown key
+        w["furniture"] = [[1.0, 2.0, 0.5]]  # not part of the schema: refused like any unknown key
         w["stations"][0]["nests"]["spacng"] = w["stations"][0]["nests"].pop("spacing")
         w["stations"][1]["marker"]["id"] = 3
 
     world = bad_world(tmp_path, three_problems)
     expected = [
-        f"{world}: obstacles: unknown key; expected one of dock, floor_size, labware_types, name, plates, "
-        "pois, robot, stations",
+        f"{world}: furniture: unknown key; expected one of dock, floor_size, labware_types, name, "
+        "obstacles, plates, pois, robot, stations",
         f"{world}: stations[0].nests.spacng: unknown key; did you mean 'spacing'?",
         f"{world}: stations[1].marker.id: marker id 3 already used",
     ]

@@ -29,6 +29,7 @@ from labware_model.labware import LabwareType, Plate
 from labware_model.workcell import StationDescription, WorkcellDescription
 from tiago_sim import transforms as tf
 from tiago_sim.lab import world_schema as schema
+from tiago_sim.lab.world_obstacles import Bench, Obstacle, dock_path_points, placement_problems
 from tiago_sim.lab.world_rules import check
 from tiago_sim.lab.world_schema import MARKER_DICTIONARY_SIZE, MIRROR_AMBIGUOUS_MARKER_IDS
 
@@ -36,6 +37,7 @@ __all__ = [
     "DEFAULT_WORLD",
     "MARKER_DICTIONARY_SIZE",
     "MIRROR_AMBIGUOUS_MARKER_IDS",
+    "Obstacle",
     "Pose2D",
     "Station",
     "World",
@@ -154,6 +156,8 @@ class World:
     extras: Mapping[str, Any] = field(default_factory=dict)
     name: str = ""
     """The lab's name (optional in the file): the SiLA servers carry it in their names."""
+    obstacles: tuple[Obstacle, ...] = ()
+    """Free-standing boxes and cylinders on the floor (world_obstacles)."""
 
     def station(self, name: str) -> Station:
         for station in self.stations:
@@ -184,7 +188,35 @@ def load_world(path: str | Path = DEFAULT_WORLD) -> World:
     model, problems = check(raw)
     if model is None:
         raise WorldError([problem.line(source) for problem in problems])
-    return _world(model, source, default_name=Path(path).stem)
+    world = _world(model, source, default_name=Path(path).stem)
+    placement = _obstacle_placement_problems(world)
+    if placement:
+        raise WorldError([f"{source}: {where}: {what}" for where, what in placement])
+    return world
+
+
+def _obstacle_placement_problems(world: World) -> list[tuple[str, str]]:
+    """Obstacles inside the floor, off the benches, clear of where the robot stands and turns."""
+    if not world.obstacles:
+        return []
+    keep_clear = {f"POI {name!r}": (pose.x, pose.y) for name, pose in world.pois.items()}
+    keep_clear["the docked pose"] = (world.dock_pose.x, world.dock_pose.y)
+    dock_poi = world.pois[world.dock_poi]
+    keep_clear.update(dock_path_points((world.dock_pose.x, world.dock_pose.y), (dock_poi.x, dock_poi.y)))
+    for station in world.stations:
+        aligned = station.aligned_pose()
+        keep_clear[f"{station.name}'s working pose"] = (aligned.x, aligned.y)
+    benches = [
+        Bench(s.name, s.table_pose.x, s.table_pose.y, s.table_pose.yaw, s.table_size[0], s.table_size[1])
+        for s in world.stations
+    ]
+    return placement_problems(world.obstacles, world.floor_size, benches, keep_clear)
+
+
+def _obstacle(item: schema.Obstacle) -> Obstacle:
+    pose = _pose(item.pose)
+    length, width = item.size or (0.0, 0.0)
+    return Obstacle(item.name, pose.x, pose.y, pose.yaw, length, width, item.radius or 0.0, item.height)
 
 
 def _pose(values: tuple[float, float, float]) -> Pose2D:
@@ -256,4 +288,5 @@ def _world(model: schema.WorldFile, source: str, default_name: str) -> World:
         model.robot.hotel_slots,
         model.floor_size,
         name=model.name or default_name,
+        obstacles=tuple(_obstacle(item) for item in model.obstacles),
     )

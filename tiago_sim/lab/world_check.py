@@ -23,7 +23,8 @@ INVALID_WORLD_EXIT_CODE = 1
 
 
 def summary(world: World) -> str:
-    """A short table: the stations with marker, nests, POI and plates; the other POIs; labware types."""
+    """A short table: the stations with marker, nests, POI and plates; the other POIs; labware types;
+    obstacles."""
     plates_at: dict[str, list[str]] = {}
     aboard = []
     for plate, holder in world.plates.items():
@@ -48,6 +49,14 @@ def summary(world: World) -> str:
     for name, labware in world.labware_types.items():
         size = f"{labware.length * 1000:.1f} x {labware.width * 1000:.1f} x {labware.height * 1000:.1f} mm"
         lines.append(f"labware type {name}: {size}, {labware.mass:g} kg")
+    for obstacle in world.obstacles:
+        outline = (
+            f"cylinder r {obstacle.radius:g} m"
+            if obstacle.is_cylinder
+            else f"box {obstacle.length:g} x {obstacle.width:g} m"
+        )
+        where = f"({obstacle.x:g}, {obstacle.y:g})"
+        lines.append(f"obstacle {obstacle.name}: {outline}, {obstacle.height:g} m tall, at {where}")
     return "\n".join(lines) + "\n"
 
 

@@ -4,7 +4,8 @@ Why: a world file is a list of poses in three frames; a mistake (a bench turned 
 marker facing the wall, a POI whose turning circle reaches into a bench) is obvious in a picture
 and easy to miss in the numbers. The robot drives straight from POI to POI and turns on the spot at
 each, so the picture draws at every POI the base footprint and the circle the onboard hotel tray
-sweeps when the robot turns. Matplotlib's Agg canvas only (headless, no pyplot state).
+sweeps when the robot turns; and the free-standing obstacles. Matplotlib's Agg canvas only
+(headless, no pyplot state).
 """
 
 from __future__ import annotations
@@ -23,8 +24,10 @@ from tiago_sim.lab.world import Pose2D, Station, World
 
 BASE_RADIUS_M = 0.265
 """TIAGo's base (tiago_sim.robot.robot_model.BASE_RADIUS; the lab layer does not import the robot)."""
-HOTEL_SWEEP_RADIUS_M = 0.35
-"""The onboard hotel tray's farthest corner from the base centre: the circle it sweeps in a turn."""
+HOTEL_SWEEP_RADIUS_M = 0.48
+"""The robot's farthest point from the base centre in the travel pose: the folded arms
+(navigation.planner.ARM_SWEEP_RADIUS_M; the hotel tray's corner is at 0.354 m): the circle it
+sweeps in a turn."""
 ARROW_M = 0.35
 PLATE_COLOURS = ("tab:orange", "tab:purple", "tab:cyan", "tab:olive", "tab:pink")
 
@@ -93,12 +96,26 @@ def _plates(ax: Axes, world: World) -> list[str]:
     return aboard
 
 
+def _obstacles(ax: Axes, world: World) -> None:
+    """The free-standing obstacles: grey boxes and discs with their names."""
+    style = {"facecolor": "slategray", "edgecolor": "black", "alpha": 0.7}
+    for obstacle in world.obstacles:
+        if obstacle.is_cylinder:
+            ax.add_patch(Circle((obstacle.x, obstacle.y), obstacle.radius, **style))
+        else:
+            ax.add_patch(Polygon(obstacle.corners(), closed=True, **style))
+        ax.text(obstacle.x, obstacle.y, obstacle.name, ha="center", va="center", fontsize=7, color="white")
+
+
 def _extent(world: World, margin: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
     """What the picture shows: everything placed, with a margin, within the floor (a large floor
     would leave the lab a speck)."""
     points = [(pose.x, pose.y) for pose in (world.dock_pose, *world.pois.values())]
     for station in world.stations:
         points += _box(station.table_pose.matrix(), *station.table_size[:2]).tolist()
+    for obstacle in world.obstacles:
+        low_x, low_y, high_x, high_y = obstacle.extent()
+        points += [(low_x, low_y), (high_x, high_y)]
     half = world.floor_size / 2 + 0.1
     low = np.maximum(np.min(points, axis=0) - margin, -half)
     high = np.minimum(np.max(points, axis=0) + margin, half)
@@ -118,6 +135,7 @@ def draw_world(world: World, path: Path) -> None:
         pocket = (0.13, 0.09) if first_type is None else (first_type.length, first_type.width)
         clearance = 2 * station.nest_clearance
         _station(ax, world, station, (pocket[0] + clearance, pocket[1] + clearance))
+    _obstacles(ax, world)
     station_pois = {station.poi for station in world.stations}
     for name, pose in world.pois.items():
         if name not in station_pois:
@@ -129,7 +147,7 @@ def draw_world(world: World, path: Path) -> None:
     ax.text(0.01, 0.99, "\n".join(notes), transform=ax.transAxes, fontsize=8, va="top", bbox={"fc": "white"})
     ax.set_title(
         f"{world.name} ({Path(world.source).name}), floor {world.floor_size:g} m\n"
-        "base footprint (filled) and hotel sweep (dashed) at each POI; dotted: working pose",
+        "base footprint (filled) and turning sweep (dashed) at each POI; dotted: working pose",
         fontsize=9,
     )
     low, high = _extent(world)

@@ -79,7 +79,8 @@ def _schema_problems(error: ValidationError, raw: dict) -> list[Problem]:
         if vector is None and detail["type"] != "missing":
             vector = _vector_prefix(loc)
         if vector is not None:  # one message for a malformed [x, y, z], not one per entry
-            problem = Problem(path_of(vector), _vector_message(_raw_at(raw, vector)))
+            length = len(_schema_at(vector)["prefixItems"])
+            problem = Problem(path_of(vector), _vector_message(_raw_at(raw, vector), length))
         else:
             problem = Problem(path_of(loc), _message(detail, loc))
         if problem not in problems:
@@ -122,10 +123,10 @@ def _unknown_key(key: str, known: list[str]) -> str:
     return f"unknown key; expected one of {', '.join(known)}" if known else "unknown key"
 
 
-def _vector_message(value: Any) -> str:
-    if isinstance(value, list) and len(value) == 3 and all(_is_number(v) for v in value):
-        return f"all sizes must be positive, got {value!r}"  # the only vector with a range
-    return f"expected a list of 3 numbers, got {value!r}"
+def _vector_message(value: Any, length: int = 3) -> str:
+    if isinstance(value, list) and len(value) == length and all(_is_number(v) for v in value):
+        return f"all sizes must be positive, got {value!r}"  # the only vectors with a range: sizes
+    return f"expected a list of {length} numbers, got {value!r}"
 
 
 _ROOT = json_schema()
@@ -194,7 +195,26 @@ def _sub(item: dict, key: str) -> dict:
 
 
 def _cross_field_problems(raw: dict) -> list[Problem]:
-    return _unique_names(raw) + _plate_problems(raw)
+    return _unique_names(raw) + _plate_problems(raw) + _obstacle_shape_problems(raw)
+
+
+def _obstacle_shape_problems(raw: dict) -> list[Problem]:
+    """A box gives size, a cylinder radius (not both); obstacle names are unique."""
+    problems: list[Problem] = []
+    names: set[Any] = set()
+    for i, obstacle in _entries(raw, "obstacles"):
+        where = f"obstacles[{i}]"
+        shape = obstacle.get("shape")
+        needed, other = {"box": ("size", "radius"), "cylinder": ("radius", "size")}.get(shape, (None, None))
+        if needed is not None and needed not in obstacle:
+            problems.append(Problem(f"{where}.{needed}", f"missing: a {shape} needs {needed}"))
+        if other is not None and other in obstacle:
+            problems.append(Problem(f"{where}.{other}", f"a {shape} has no {other}; give {needed} only"))
+        name = obstacle.get("name")
+        if isinstance(name, str) and name in names:
+            problems.append(Problem(f"{where}.name", f"duplicate obstacle name {name!r}"))
+        names.add(name if isinstance(name, str) else None)
+    return problems
 
 
 def _unique_names(raw: dict) -> list[Problem]:

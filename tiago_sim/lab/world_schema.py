@@ -204,6 +204,41 @@ class PlateStart(_Strict):
     )
 
 
+class Obstacle(_Strict):
+    """A free-standing obstacle on the floor (a cart, a pillar, a wall, a fridge): a box or an
+    upright cylinder standing on the floor. It is built in the physics, drawn, and on the map."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "oneOf": [
+                {
+                    "properties": {"shape": {"const": "box"}},
+                    "required": ["size"],
+                    "not": {"required": ["radius"]},
+                },
+                {
+                    "properties": {"shape": {"const": "cylinder"}},
+                    "required": ["radius"],
+                    "not": {"required": ["size"]},
+                },
+            ]
+        }
+    )
+
+    name: Text = Field(description="unique obstacle name (collision reports name it)")
+    shape: Literal["box", "cylinder"] = Field(description="'box' (give size) or 'cylinder' (give radius)")
+    pose: PoseList = Field(
+        description="[x, y, yaw_deg] of the obstacle's centre on the floor, world frame (m, m, degrees)"
+    )
+    size: tuple[Positive, Positive] | None = Field(
+        None, description="box only: [length, width] (m), length along the pose's heading"
+    )
+    radius: Annotated[Number, Field(gt=0.0, le=5.0)] | None = Field(
+        None, description="cylinder only: radius (m)"
+    )
+    height: Number = Field(1.0, gt=0.0, le=3.0, description="height above the floor (m)")
+
+
 class WorldFile(_Strict):
     """A lab for the simulated TIAGo++: dock, POIs, stations with markers and nests, labware, plates.
     Units: metres, kilograms; angles in degrees."""
@@ -226,6 +261,11 @@ class WorldFile(_Strict):
     stations: list[Station] = Field(min_length=1, description="one entry per station, any number")
     plates: list[PlateStart] = Field(
         default_factory=list, description="the plates at the start, each in a nest or a hotel slot"
+    )
+    obstacles: list[Obstacle] = Field(
+        default_factory=list,
+        description="free-standing boxes and cylinders on the floor (besides the benches and the "
+        "floor's edge walls); inside the floor, clear of every bench, POI and the dock",
     )
 
 

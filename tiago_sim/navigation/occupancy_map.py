@@ -14,9 +14,12 @@ import cv2
 import numpy as np
 
 from tiago_sim.lab.world import World
+from tiago_sim.robot.robot_model import BASE_RADIUS
 
 DEFAULT_RESOLUTION = 0.05  # m per cell (the ROS 2 navigation stack's usual resolution)
 WALL_THICKNESS = 0.10  # m: the floor's edge is a wall this thick, inside the floor
+DOCK_GAP = 0.002  # m between the docked robot's rear and the dock's contact plate
+DOCK_SIZE = (0.10, 0.45, 0.30)  # m: depth (along the docked heading), width, height
 
 
 @dataclass(frozen=True)
@@ -93,9 +96,22 @@ def station_footprints(world: World) -> list[Footprint]:
     ]
 
 
+def obstacle_footprints(world: World) -> list[Footprint]:
+    """Every free-standing obstacle's outline (boxes and cylinders of the world file)."""
+    return [Footprint(o.x, o.y, o.yaw, o.length, o.width, o.radius) for o in world.obstacles]
+
+
+def dock_footprint(world: World) -> Footprint:
+    """The charging dock's outline: behind the docked robot (physics.scene builds it there)."""
+    dock = world.dock_pose
+    behind = BASE_RADIUS + DOCK_GAP + DOCK_SIZE[0] / 2
+    return Footprint(
+        dock.x - behind * math.cos(dock.yaw), dock.y - behind * math.sin(dock.yaw), dock.yaw, *DOCK_SIZE[:2]
+    )
+
+
 def build_map(world: World, resolution: float = DEFAULT_RESOLUTION) -> OccupancyMap:
-    """The static map: the floor's edge walls and every bench (and, once the world file has them,
-    its free-standing obstacles: add their outlines to ``station_footprints``' list)."""
+    """The static map: the floor's edge walls, the dock, every bench and every free-standing obstacle."""
     half = world.floor_size / 2
     cells = math.ceil(world.floor_size / resolution)
     empty = OccupancyMap(resolution, (-half, -half), np.zeros((cells, cells), dtype=bool))
@@ -104,7 +120,9 @@ def build_map(world: World, resolution: float = DEFAULT_RESOLUTION) -> Occupancy
     grid[:wall_cells, :] = grid[-wall_cells:, :] = True
     grid[:, :wall_cells] = grid[:, -wall_cells:] = True
     walled = OccupancyMap(resolution, empty.origin, grid)
-    return walled.with_footprints(station_footprints(world))
+    return walled.with_footprints(
+        [dock_footprint(world), *station_footprints(world), *obstacle_footprints(world)]
+    )
 
 
 def _draw(grid: np.ndarray, grid_map: OccupancyMap, footprint: Footprint) -> None:

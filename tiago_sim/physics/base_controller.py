@@ -93,6 +93,14 @@ class DiffDriveBase:
         self.v_cmd = min(max(v, -rm.MAX_LINEAR_SPEED), rm.MAX_LINEAR_SPEED)
         self.w_cmd = min(max(w, -rm.MAX_ANGULAR_SPEED), rm.MAX_ANGULAR_SPEED)
 
+    def protective_stop(self) -> None:
+        """Cut the drive at once (a collision): velocity and command zero, the base held where it
+        stands. A real base's protective stop brakes far beyond the 0.5 m/s^2 of normal driving;
+        braking at that rate from 1 m/s would carry the robot 1 m on into what it hit."""
+        self.v = self.w = self.v_cmd = self.w_cmd = 0.0
+        self.target = list(self.body.base_xy_yaw())
+        self.body.set_base_target(*self.target)
+
     def stopped(self) -> bool:
         """The command has ramped to zero and the base itself stands still (it lags the command,
         so a drive that reports "stopped" on the command alone would still be rolling)."""

@@ -19,7 +19,8 @@ import pybullet as p
 from labware_model.holders import HotelSlot, Nest
 from labware_model.labware import LabwareType
 from tiago_sim import transforms as tf
-from tiago_sim.lab.world import Station, World
+from tiago_sim.lab.world import Obstacle, Station, World
+from tiago_sim.navigation.occupancy_map import DOCK_GAP, DOCK_SIZE, WALL_THICKNESS
 from tiago_sim.perception.marker_asset import marker_visual
 from tiago_sim.robot.hotel_model import corner_ramp_boxes
 from tiago_sim.robot.robot_model import BASE_RADIUS
@@ -34,8 +35,7 @@ NEST_RAMP_FOOT = 0.001  # the ramp runs on this far below the bench top: no edge
 NEST_LEG_LENGTH = 0.015  # bracket legs run this far in from each corner
 NEST_FRICTION = 0.15  # polished lead-ins: with the plate's 1.0, the pair's friction is 0.15
 TABLE_FRICTION = 0.3  # laminate bench top: plate on table 0.3
-DOCK_GAP = 0.002  # between the docked robot's rear and the dock's contact plate
-DOCK_SIZE = (0.10, 0.45, 0.30)
+WALL_HEIGHT = 1.0  # m: the floor's edge walls (the map's walls; the base laser sees them)
 
 
 @dataclass
@@ -47,6 +47,9 @@ class Scene:
     tables: dict[str, int] = field(default_factory=dict)
     nests: dict[Nest, int] = field(default_factory=dict)
     markers: dict[str, int] = field(default_factory=dict)
+    marker_stands: dict[str, int] = field(default_factory=dict)
+    obstacles: dict[str, int] = field(default_factory=dict)
+    walls: dict[str, int] = field(default_factory=dict)
     plates: dict[str, int] = field(default_factory=dict)
     plate_types: dict[str, LabwareType] = field(default_factory=dict)
 
@@ -119,7 +122,9 @@ def _build_station(client: int, station: Station, labware: LabwareType, scene: S
     board = station.marker_size * 1.4
     stand_height = station.marker_xyz[2] + board / 2
     T_world_board = T_world_marker @ tf.make_transform((0, stand_height / 2 - station.marker_xyz[2], -0.006))
-    _static_box(client, (board, stand_height, 0.01), T_world_board, [0.95, 0.95, 0.95, 1])
+    scene.marker_stands[station.name] = _static_box(
+        client, (board, stand_height, 0.01), T_world_board, [0.95, 0.95, 0.95, 1]
+    )
     T_world_tile = T_world_marker @ tf.make_transform((0, 0, 0.0008))
     scene.markers[station.name] = marker_visual(client, station.marker_id, station.marker_size, T_world_tile)
     pocket = (labware.length + 2 * station.nest_clearance, labware.width + 2 * station.nest_clearance)
@@ -152,6 +157,42 @@ def _plate_body(client: int, labware: LabwareType, T_world_bottom: np.ndarray) -
     return body
 
 
+def _build_walls(client: int, floor_size: float) -> dict[str, int]:
+    """Four thin walls standing on the floor's edge, inside it, as the occupancy map has them."""
+    half, inner = floor_size / 2, floor_size / 2 - WALL_THICKNESS / 2
+    rgba = [0.6, 0.6, 0.65, 1]
+    long_side = (floor_size, WALL_THICKNESS, WALL_HEIGHT)
+    across = (WALL_THICKNESS, floor_size, WALL_HEIGHT)
+    z = WALL_HEIGHT / 2
+    log.debug("edge walls at +-%.2f m", half)
+    return {
+        "north wall": _static_box(client, long_side, tf.make_transform((0, inner, z)), rgba),
+        "south wall": _static_box(client, long_side, tf.make_transform((0, -inner, z)), rgba),
+        "east wall": _static_box(client, across, tf.make_transform((inner, 0, z)), rgba),
+        "west wall": _static_box(client, across, tf.make_transform((-inner, 0, z)), rgba),
+    }
+
+
+def _obstacle_body(client: int, obstacle: Obstacle) -> int:
+    """A static box or upright cylinder standing on the floor."""
+    T_world_centre = tf.from_planar(obstacle.x, obstacle.y, obstacle.yaw, obstacle.height / 2)
+    rgba = [0.45, 0.5, 0.6, 1]
+    if not obstacle.is_cylinder:
+        return _static_box(client, (obstacle.length, obstacle.width, obstacle.height), T_world_centre, rgba)
+    collision = p.createCollisionShape(
+        p.GEOM_CYLINDER, radius=obstacle.radius, height=obstacle.height, physicsClientId=client
+    )
+    visual = p.createVisualShape(
+        p.GEOM_CYLINDER,
+        radius=obstacle.radius,
+        length=obstacle.height,
+        rgbaColor=rgba,
+        physicsClientId=client,
+    )
+    position, quat = tf.to_pose(T_world_centre)
+    return p.createMultiBody(0.0, collision, visual, position.tolist(), quat.tolist(), physicsClientId=client)
+
+
 def plate_bottom_pose(client: int, body: int, labware: LabwareType) -> np.ndarray:
     """T_world of the plate's bottom-centre frame (what a nest site frame should coincide with)."""
     position, quat = p.getBasePositionAndOrientation(body, physicsClientId=client)
@@ -173,6 +214,8 @@ def build_scene(client: int, world: World, T_world_hotel_slots: dict[int, np.nda
         (-(BASE_RADIUS + DOCK_GAP + DOCK_SIZE[0] / 2), 0, DOCK_SIZE[2] / 2)
     )
     scene.dock = _static_box(client, DOCK_SIZE, T_world_dock, [0.2, 0.3, 0.2, 1])
+    scene.walls = _build_walls(client, world.floor_size)
+    scene.obstacles = {obstacle.name: _obstacle_body(client, obstacle) for obstacle in world.obstacles}
     default_type = next(iter(world.labware_types.values()))
     for station in world.stations:
         _build_station(client, station, default_type, scene)

@@ -19,12 +19,16 @@ import pybullet as p
 from labware_model.holders import Nest
 from labware_model.readings import HotelSlotReading, NestReading, PlacementCheck
 from tiago_sim.lab.world import World
+from tiago_sim.navigation.planner import Plan
 from tiago_sim.perception.camera import CameraIntrinsics, render_rgbd
 from tiago_sim.physics.arm_controller import JointTrajectoryMotion
 from tiago_sim.physics.base_controller import DiffDriveBase, DriveMotion, docking_motion
+from tiago_sim.physics.collision_watch import COLLISION, CollisionWatch
 from tiago_sim.physics.gripper_controller import HOLDER_FRICTION, Gripper, GripperMotion
 from tiago_sim.physics.hotel_clamp import HotelClamp
 from tiago_sim.physics.motion import BUSY, CompletedMotion, FailedMotion, Motion
+from tiago_sim.physics.path_following import path_motion
+from tiago_sim.physics.plate_proximity import STEP_REVIEW_PERIOD, PlateProximity
 from tiago_sim.physics.plate_sensing import PlateSensing
 from tiago_sim.physics.robot_body import RobotBody
 from tiago_sim.physics.scene import build_scene
@@ -59,11 +63,6 @@ FREE_MOTION_STEP_RATIO = 4
 # 1/60 s and 0.45, 11.1 ms at 1/60 s and 0.6).
 CONSTRAINT_ERP = 0.2
 FREE_MOTION_CONSTRAINT_ERP = 0.5
-PLATE_NEAR_RANGE = 0.15  # m between a moving robot link and a plate: a finger contact may start soon
-STEP_REVIEW_PERIOD = 0.05  # s of sim time between proximity checks (tool <= 1.5 m/s: 7.5 cm)
-# A held plate is within reach of something when it is closer than this margin plus twice the
-# distance it travels in a review period at its current speed (it cannot get there unnoticed).
-HELD_PLATE_MARGIN = 0.03  # m
 LOADED_TURN_RATE = 0.05  # rad/s: above it, with an unclamped plate in the hotel, steps stay short
 DOCK_SENSOR_RANGE = 0.004  # m: the charging contacts close within this distance
 TOOL_SPEED = 0.08  # m/s along straight tool moves unless the caller asks otherwise
@@ -107,14 +106,7 @@ class Simulation:
         self.grippers = {side: Gripper(self.robot, side, self.scene.plates) for side in rm.ARM_SIDES}
         self.hotel_clamp = HotelClamp(self.robot, self.scene.plates)
         self._clamped_for_drive = False
-        self._own_arm_links = {
-            side: {
-                index
-                for name, index in self.robot.link_index.items()
-                if name.startswith((f"arm_{side}_", f"gripper_{side}_"))
-            }
-            for side in rm.ARM_SIDES
-        }
+        self.plate_proximity = PlateProximity(c, self.robot, self.scene.plates, self.grippers)
         self.kinematics = RobotKinematics()
         # The head camera's true mount against the model's head_camera_optical_frame (a hand-eye
         # calibration error; identity unless tiago_sim.measuring.disturbances sets one).
@@ -125,6 +117,7 @@ class Simulation:
         self.last_step_s = time_step  # length of the latest physics step (s)
         self.step_ledger = StepLedger()
         self.plate_sensing = PlateSensing(c, world, self.robot, self.scene, self.grippers)
+        self.collision_watch = CollisionWatch(c, self.robot, self.scene)
         self._reviewed_at = -1.0
         self._plate_within_range = True
         self._turning_loaded = False
@@ -150,6 +143,7 @@ class Simulation:
         self.base.update(dt)
         started = time.thread_time()
         p.stepSimulation(physicsClientId=self.client_id)
+        self._stop_on_collision()
         self._check_holds(dt)
         self.step_ledger.record(dt, self._iterations, time.thread_time() - started)
         self.base.integrate_odometry(dt)
@@ -157,6 +151,14 @@ class Simulation:
         self.last_step_s = dt
         if any(m.done for m in motions):
             self.motions = [m for m in motions if not m.done]
+
+    def _stop_on_collision(self) -> None:
+        """An unintended contact (collision_watch) stops the base at once and fails every running
+        motion, naming it."""
+        for collision in self.collision_watch.check(self.sim_time):
+            self.base.protective_stop()
+            for motion in self.motions:
+                motion.finish(False, COLLISION, collision.text())
 
     def _clamp_while_driving(self, base_driven: bool) -> None:
         """The hotel clamp closes when a base motion starts and opens once the base stands."""
@@ -185,7 +187,7 @@ class Simulation:
         )
         if not grasping and self.sim_time - self._reviewed_at >= STEP_REVIEW_PERIOD - 1e-9:
             self._reviewed_at = self.sim_time
-            self._plate_within_range = self._robot_near_resting_plate() or self._held_plate_near_anything()
+            self._plate_within_range = self.plate_proximity.plate_within_range(self._held_plates())
             turn_rate = max(abs(self.base.w), abs(self.base.w_cmd))
             self._turning_loaded = turn_rate > LOADED_TURN_RATE and bool(
                 self.hotel_clamp.resting_on_tray(self._held_plates() | set(self.hotel_clamp.constraints))
@@ -201,37 +203,6 @@ class Simulation:
             erp = CONSTRAINT_ERP if step == self.time_step else FREE_MOTION_CONSTRAINT_ERP
             p.setPhysicsEngineParameter(fixedTimeStep=step, erp=erp, physicsClientId=self.client_id)
         return step
-
-    def _robot_near_resting_plate(self) -> bool:
-        """A robot link other than the base (its hotel tray carries plates) near a plate no gripper holds."""
-        held = self._held_plates()
-        return any(
-            point[3] != -1
-            for labware_id, plate in self.scene.plates.items()
-            if labware_id not in held
-            for point in p.getClosestPoints(
-                self.robot.id, plate, PLATE_NEAR_RANGE, physicsClientId=self.client_id
-            )
-        )
-
-    def _held_plate_near_anything(self) -> bool:
-        """A held plate within reach of a body, or of a robot link other than its own arm's."""
-        c = self.client_id
-        for side, gripper in self.grippers.items():
-            if not gripper.attached_id:
-                continue
-            plate = self.scene.plates[gripper.attached_id]
-            speed = float(np.linalg.norm(p.getBaseVelocity(plate, physicsClientId=c)[0]))
-            reach = HELD_PLATE_MARGIN + 2.0 * speed * STEP_REVIEW_PERIOD
-            own_links = self._own_arm_links[side]
-            for index in range(p.getNumBodies(physicsClientId=c)):
-                other = p.getBodyUniqueId(index, physicsClientId=c)
-                if other == plate:
-                    continue
-                for point in p.getClosestPoints(plate, other, reach, physicsClientId=c):
-                    if other != self.robot.id or point[4] not in own_links:
-                        return True
-        return False
 
     def busy(self) -> bool:
         return any(not m.done for m in self.motions)
@@ -310,6 +281,12 @@ class Simulation:
         if self.is_docked():
             return FailedMotion("drive", "DOCKED", "undock first")
         return self._start(DriveMotion(self.base, x, y, yaw, speed=speed))
+
+    def follow_path(self, plan: Plan, yaw: float, speed: float = rm.MAX_LINEAR_SPEED) -> Motion:
+        """Drive a planned path (navigation.planner) segment by segment, ending facing ``yaw``."""
+        if self.is_docked():
+            return FailedMotion("drive", "DOCKED", "undock first")
+        return self._start(path_motion(self.base, plan, yaw, speed=speed))
 
     def dock(self) -> Motion:
         if self.is_docked():

@@ -22,6 +22,7 @@ from tiago_sim.robot.kinematics import RobotKinematics
 from tiago_sim.robot.motion_library import HOTEL_MOTIONS, MotionLibrary
 from tiago_sim.robot.robot_model import ARM_SIDES
 from tiago_sim.sim_node.action_run import ActionAbort, ActionRun
+from tiago_sim.sim_node.navigation import Navigation
 from tiago_sim.transforms import make_transform
 
 log = logging.getLogger(__name__)
@@ -49,6 +50,7 @@ class RobotBehaviours:
         hotel_slots: int,
         motions: MotionLibrary,
         speed_scale: Callable[[], float],
+        navigation: Navigation,
     ) -> None:
         self.poi_pose = poi_pose
         self.poi_names = poi_names
@@ -56,6 +58,7 @@ class RobotBehaviours:
         self.hotel_slots = hotel_slots
         self.motions = motions
         self.speed_scale = speed_scale
+        self.navigation = navigation  # plans and drives around obstacles
         self._kinematics = RobotKinematics()
         self._kinematics_lock = threading.Lock()
         self.grasp_flipped: dict[str, bool] = {}  # per arm: twin of the top-down grasp last used
@@ -87,7 +90,7 @@ class RobotBehaviours:
             raise ActionAbort(ErrorCodes.DOCKED, "the robot is docked: undock first")
         lowering = self._lower_torso(run)
         try:
-            run.run_motion(lambda sim: sim.drive_to(*pose), span=(0.0, 0.95))
+            self.navigation.drive(run, pose, f"POI {goal.poi!r}", span=(0.0, 0.95))
             if lowering is not None:
                 run.run_motion(lambda _sim: lowering, span=(0.95, 1.0))
         except BaseException:
@@ -115,7 +118,9 @@ class RobotBehaviours:
             return {}
         pose = self.poi_pose(self.dock_poi())
         if pose is not None:
-            run.run_motion(lambda sim: sim.drive_to(*pose), span=(0.0, 0.6), later_s=10.0)
+            self.navigation.drive(
+                run, pose, f"the dock POI {self.dock_poi()!r}", span=(0.0, 0.6), later_s=10.0
+            )
         run.run_motion(lambda sim: sim.dock(), span=(0.6 if pose is not None else 0.0, 1.0))
         return {}
 

@@ -6,8 +6,8 @@
 Threads: the sim thread (sim_thread.SimThread) owns the Simulation and steps it; a
 MultiThreadedExecutor spins the node on the main thread; action execute callbacks and timers only
 hand jobs to the sim thread and wait on futures. Offers the robot-level actions (ros_actions),
-the sensor topics (ros_publishers), /describe_workcell and /check_placement (ground truth, for
-success checks only).
+the sensor topics (ros_publishers), /map, /global_costmap/costmap and /plan (navigation),
+/describe_workcell and /check_placement (ground truth, for success checks only).
 
 ROS parameters (changeable at runtime): ``pois.<name>`` = [x, y, yaw] (from the world YAML),
 ``stations.<name>.approach_height_m``, ``speed_scale``, ``realtime_factor_cap`` (0 = none),
@@ -25,6 +25,7 @@ import argparse
 import dataclasses
 import logging
 import sys
+from array import array
 from pathlib import Path
 from typing import Any
 
@@ -44,6 +45,7 @@ from tiago_sim.sim_node.action_servers import RobotActionServers
 from tiago_sim.sim_node.behaviours import RobotBehaviours
 from tiago_sim.sim_node.lab_reset import LabReset
 from tiago_sim.sim_node.marker_motion import MarkerMotionBehaviour
+from tiago_sim.sim_node.navigation import Navigation
 from tiago_sim.sim_node.publishers import StatePublishers
 from tiago_sim.sim_node.sim_thread import SimThread
 
@@ -72,6 +74,7 @@ class SimNode:
             hotel_slots=world.hotel_slots,
             motions=motions,
             speed_scale=lambda: float(node.get_parameter("speed_scale").value),
+            navigation=Navigation(node, world),
         )
         self.marker_motion = MarkerMotionBehaviour(world, self.behaviours, motions.hotel)
         self.actions = RobotActionServers(
@@ -110,7 +113,8 @@ class SimNode:
     def _on_parameters(self, parameters: list[Parameter]) -> SetParametersResult:
         for parameter in parameters:
             name, value = parameter.name, parameter.value
-            if name.startswith("pois.") and (not isinstance(value, (list, tuple)) or len(value) != 3):
+            # a double array arrives over ROS as array.array, from a launch file as a list
+            if name.startswith("pois.") and (not isinstance(value, (list, tuple, array)) or len(value) != 3):
                 return SetParametersResult(successful=False, reason=f"{name} must be [x, y, yaw]")
             if name == "speed_scale" and not 0.05 <= float(value) <= 2.0:
                 return SetParametersResult(successful=False, reason="speed_scale must be in 0.05 .. 2.0")
@@ -237,6 +241,11 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser.add_argument("--disturbance-levels", default="", help="DisturbanceLevels JSON")
     parser.add_argument("--record-dir", type=Path, default=None, help="save camera frames here")
     parser.add_argument("--log-level", default="INFO")
+    parser.add_argument(
+        "--near-misses",
+        action="store_true",
+        help="log robot parts passing within 1 cm of the lab (measuring)",
+    )
     return parser.parse_args(argv)
 
 
@@ -254,6 +263,10 @@ def make_simulation(simulation_class: Any, world: World, args: argparse.Namespac
             odometry_noise=disturbance.levels.odometry_noise,
         )
         disturbances.apply_to_simulation(sim, disturbance)
+    if getattr(args, "near_misses", False):
+        from tiago_sim.physics.collision_watch import NEAR_MISS_PERIOD_S
+
+        sim.collision_watch.near_miss_period_s = NEAR_MISS_PERIOD_S
     if args.record_dir is not None:
         from tiago_sim.measuring.run_recorder import RunRecorder
 

@@ -110,6 +110,15 @@ def test_disturbances_are_seeded_and_move_the_true_world_only() -> None:
         ),
         ("LabwareNotPlaced: Robot.PutLabware: PutLabware failed (MOTION_FAILED): arm stalled", "positioning"),
         ("StepTimeout: Robot.PutLabware: not finished after 900 s: Robot.PutLabware", "other"),
+        (
+            "UndefinedServerError: Robot.PrepareForOutput: driving to station_b_work failed (COLLISION): "
+            "the hotel tray (base_footprint) touched obstacle bench_c (13.2 mm deep)",
+            "collision",
+        ),
+        (
+            "LabwareNotPlaced: PutLabware failed (COLLISION): arm_right_4_link touched station_b table",
+            "collision",
+        ),
     ],
 )
 def test_every_failure_message_gets_a_cause(error: str, cause: str) -> None:

@@ -17,6 +17,7 @@ from tests.helpers.sila_stack import DEFAULT_WORLD, start_stack
 EXAMPLES = sorted(path for path in DEFAULT_WORLD.parent.glob("*.yaml") if path != DEFAULT_WORLD)
 # what the demo moves in each: the plate, from, to
 EXPECTED = {
+    "bench_in_the_way": ("plate_001", "station_a/1", "station_b/1"),  # around bench_c, untouched
     "two_benches": ("plate_b", "bench_a/2", "bench_b/1"),
     "three_stations": ("mp_001", "reader/1", "incubator/1"),
 }

@@ -38,14 +38,14 @@ def test_every_shipped_world_is_checked_summed_up_and_drawn(tmp_path: Path, path
 
 def test_an_invalid_world_exits_1_with_one_line_per_problem(tmp_path: Path, capsys) -> None:
     path = tmp_path / "lab.yaml"
-    path.write_text(SCHEMA_FILE.parent.joinpath("default.yaml").read_text() + "obstacles: []\nstatoins: 1\n")
+    path.write_text(SCHEMA_FILE.parent.joinpath("default.yaml").read_text() + "furniture: []\nstatoins: 1\n")
     picture = tmp_path / "lab.png"
     assert main([str(path), "--png", str(picture)]) == 1
     captured = capsys.readouterr()
     assert captured.out == "" and not picture.exists()
     assert captured.err.splitlines() == [
-        f"{path}: obstacles: unknown key; expected one of dock, floor_size, labware_types, name, plates, "
-        "pois, robot, stations",
+        f"{path}: furniture: unknown key; expected one of dock, floor_size, labware_types, name, "
+        "obstacles, plates, pois, robot, stations",
         f"{path}: statoins: unknown key; did you mean 'stations'?",
     ]
 

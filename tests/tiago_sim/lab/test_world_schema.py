@@ -72,10 +72,10 @@ RULES: list[tuple[str, Mutation, str]] = [
         "plates[0].sub_postion: unknown key; did you mean 'sub_position'?",
     ),
     (
-        "an obstacles list is no part of the schema",
-        lambda d: d.update(obstacles=[[1.0, 2.0, 0.3]]),
-        "obstacles: unknown key; expected one of dock, floor_size, labware_types, name, plates, pois, robot, "
-        "stations",
+        "a furniture list is no part of the schema",
+        lambda d: d.update(furniture=[[1.0, 2.0, 0.3]]),
+        "furniture: unknown key; expected one of dock, floor_size, labware_types, name, obstacles, plates, "
+        "pois, robot, stations",
     ),
     # missing keys and types
     ("missing key", lambda d: station(0, "table")(d).pop("pose"), "stations[0].table.pose: missing"),
