@@ -216,6 +216,14 @@ class RobotLink:
         """The latest sensor reading of every nest (waits for the first message up to `timeout_s`)."""
         return nest_readings_from_message(self._ros.station_states.wait_for_message(timeout_s))
 
+    def next_nest_readings(self, timeout_s: float = 5.0) -> tuple[NestReading, ...]:
+        """The nest readings of the next /station_states message to arrive (not the latest one)."""
+        mirror = self._ros.station_states
+        current = mirror.latest
+        return nest_readings_from_message(
+            mirror.wait_for_message(timeout_s, lambda message: message is not current)
+        )
+
     def wait_for_robot_status(
         self, predicate: Callable[[RobotStatus], bool], timeout_s: float = 5.0
     ) -> RobotStatus:

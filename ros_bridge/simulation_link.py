@@ -18,10 +18,12 @@ from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
 from rcl_interfaces.srv import SetParameters
 from std_srvs.srv import Trigger
 
+from labware_model.readings import NestReading
 from ros_bridge.errors import BridgeError
 from ros_bridge.robot_link import RobotLink
 from ros_bridge.runtime import RosRuntime
 from ros_bridge.services import ServiceCaller
+from ros_bridge.workcell import RobotStatus
 
 logger = logging.getLogger(__name__)
 
@@ -68,6 +70,13 @@ class SimulationLink:
         if not response.success:
             raise SimulationRefused(response.message)
         return str(response.message)
+
+    def reports_after_reset(self, timeout_s: float = 10.0) -> tuple[RobotStatus, tuple[NestReading, ...]]:
+        """The robot state and nest readings the robot side took after a reset returned: the state
+        stamped after the one current now, then the next nest message (it follows the state)."""
+        before = self._link.robot_status().stamp_s
+        status = self._link.wait_for_robot_status(lambda s: s.stamp_s > before, timeout_s)
+        return status, self._link.next_nest_readings(timeout_s)
 
     def set_parameters(self, values: dict[str, str | float], timeout_s: float = 10.0) -> None:
         """Set sim node parameters at once; SimulationRefused names the first one refused and why."""

@@ -16,7 +16,9 @@ import threading
 from collections.abc import Sequence
 from typing import Protocol
 
+from labware_model.readings import NestReading
 from ros_bridge.errors import BridgeError
+from ros_bridge.workcell import RobotStatus
 from sila_labware.device.errors import CommandSequenceError, ParameterError
 from sila_labware.device.robot_controller import RobotController
 from sila_labware.device.station_controller import StationController
@@ -39,6 +41,8 @@ class SimulationBackend(Protocol):
     def reset_lab(self, timeout_s: float = ...) -> str: ...
 
     def set_parameters(self, values: dict[str, str | float], timeout_s: float = ...) -> None: ...
+
+    def reports_after_reset(self, timeout_s: float = ...) -> tuple[RobotStatus, tuple[NestReading, ...]]: ...
 
 
 class RobotBusy(Exception):
@@ -143,12 +147,7 @@ class SimulatedLab:
 
     def _take_inventory_anew(self) -> None:
         """Every plate the inventory knows goes where the robot side's next reports put it."""
-        link = self.robot.link
-        # The report current when the reset returned may have been taken just before it: wait for
-        # the one after it (the robot side stamps reports with its simulated clock).
-        before = link.robot_status().stamp_s
-        status = link.wait_for_robot_status(lambda s: s.stamp_s > before, REPORT_AFTER_RESET_S)
-        nests = link.nest_readings()
+        status, nests = self.simulation.reports_after_reset(REPORT_AFTER_RESET_S)
         for record in self.robot.inventory.records():
             self.robot.inventory.settle(record.labware_id, record.labware_type, None, status, nests)
 
