@@ -171,9 +171,10 @@ class World:
         )
 
 
-def load_world(path: str | Path = DEFAULT_WORLD) -> World:
+def load_world(path: str | Path = DEFAULT_WORLD, *, check_robot: bool = True) -> World:
     """Read and validate a world file; raises WorldError listing every problem, each with the file and
-    the field."""
+    the field. `check_robot`: also refuse what the TIAGo++ cannot serve (`serviceability`: a bench
+    under the base or in the tray's turning circle, a nest out of reach, a marker out of view)."""
     source = str(path)
     try:
         raw = yaml.safe_load(Path(path).read_text())
@@ -184,7 +185,14 @@ def load_world(path: str | Path = DEFAULT_WORLD) -> World:
     model, problems = check(raw)
     if model is None:
         raise WorldError([problem.line(source) for problem in problems])
-    return _world(model, source, default_name=Path(path).stem)
+    world = _world(model, source, default_name=Path(path).stem)
+    if check_robot:
+        from tiago_sim.lab.serviceability import service_problems  # pinocchio: only when checking
+
+        refused = service_problems(world)
+        if refused:
+            raise WorldError([f"{source}: {problem.where}: {problem.what}" for problem in refused])
+    return world
 
 
 def _pose(values: tuple[float, float, float]) -> Pose2D:
