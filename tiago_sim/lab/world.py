@@ -41,6 +41,7 @@ __all__ = [
     "World",
     "WorldError",
     "load_world",
+    "world_from_raw",
 ]
 
 DEFAULT_WORLD = Path(__file__).resolve().parents[1] / "worlds" / "default.yaml"
@@ -182,10 +183,16 @@ def load_world(path: str | Path = DEFAULT_WORLD, *, check_robot: bool = True) ->
         raise WorldError([f"{source}: cannot read: {error}"]) from error
     except yaml.YAMLError as error:
         raise WorldError([f"{source}: not valid YAML: {' '.join(str(error).split())}"]) from error
+    return world_from_raw(raw, source, Path(path).stem, check_robot=check_robot)
+
+
+def world_from_raw(raw: Any, source: str, default_name: str = "lab", *, check_robot: bool = True) -> World:
+    """The checks of `load_world` on an already parsed file (a generated layout, say); `source` names
+    it in the messages."""
     model, problems = check(raw)
     if model is None:
         raise WorldError([problem.line(source) for problem in problems])
-    world = _world(model, source, default_name=Path(path).stem)
+    world = _world(model, source, default_name=default_name)
     if check_robot:
         from tiago_sim.lab.serviceability import service_problems  # pinocchio: only when checking
 
