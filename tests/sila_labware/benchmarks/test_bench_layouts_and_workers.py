@@ -61,18 +61,8 @@ def test_save_layout_writes_the_trial_seeds_world_file(tmp_path: Path) -> None:
 
 def test_random_layouts_on_two_workers_report_in_seed_order(tmp_path: Path) -> None:
     report = tmp_path / "report"
-    done = run_bench(
-        "--random-layouts",
-        "--trials",
-        "2",
-        "--jobs",
-        "2",
-        "--seed",
-        str(SEED),
-        "--json",
-        "--report",
-        str(report),
-    )
+    flags = ["--random-layouts", "--trials", "2", "--jobs", "2", "--seed", str(SEED), "--json"]
+    done = run_bench(*flags, "--report", str(report))
     assert done.stdout.strip(), done.stderr[-3000:]
     summary = json.loads(done.stdout)
     assert (summary["jobs"], summary["random_layouts"], summary["trials"]) == (2, True, 2)
