@@ -79,7 +79,7 @@ def add_bench_arguments(bench: argparse.ArgumentParser) -> None:
     bench.add_argument(
         "--jobs",
         type=int,
-        default=os.cpu_count() or 1,
+        default=len(os.sched_getaffinity(0)),  # the cores this process may run on
         help="trials run side by side, each with its own robot side, SiLA ports (--port-base + 10 per "
         "worker) and ROS domain (default: the cores, %(default)s)",
     )
