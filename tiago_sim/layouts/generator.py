@@ -16,7 +16,7 @@ microplate and a 96-well deep-well plate, both SBS footprint.
 
 Layout rules beyond the loader's: everything stays 0.3 m inside the floor's walls, and the straight
 drives between the dock's POI and the stations' POIs keep the hotel tray's turning circle
-(0.40 m) off every bench, since navigation drives straight from POI to POI today.
+(0.40 m) off every bench and the dock, since navigation drives straight from POI to POI today.
 Pure; any thread.
 """
 
@@ -24,10 +24,11 @@ from __future__ import annotations
 
 import math
 import random
+from dataclasses import dataclass
 from typing import Any
 
 from tiago_sim.lab.serviceability import BASE_RADIUS, HOTEL_SWEEP_RADIUS, TURN_MARGIN, bench_distance
-from tiago_sim.lab.world import World, WorldError, world_from_raw
+from tiago_sim.lab.world import Pose2D, World, WorldError, world_from_raw
 from tiago_sim.lab.world_schema import MARKER_DICTIONARY_SIZE, MIRROR_AMBIGUOUS_MARKER_IDS
 from tiago_sim.layouts.station_draw import LABWARE_TYPES, RANGES, draw_station
 
@@ -38,6 +39,27 @@ CORRIDOR = HOTEL_SWEEP_RADIUS + TURN_MARGIN
 WORKING_CLEARANCE = BASE_RADIUS + 0.05  # the base at a working pose, from every bench
 PLACEMENT_TRIES = 300  # per station, before the whole floor is drawn again
 LAYOUT_TRIES = 50
+
+
+DOCK_BOX = (0.10, 0.45)  # m, the dock's footprint (tiago_sim.physics.scene.DOCK_SIZE)
+DOCK_BOX_BEHIND = BASE_RADIUS + 0.002 + DOCK_BOX[0] / 2  # its centre behind the docked base's centre
+
+
+@dataclass(frozen=True)
+class _Box:
+    """An obstacle's outline as `bench_distance` reads a station's: pose of its centre, depth, width."""
+
+    table_pose: Pose2D
+    table_size: tuple[float, float, float]
+
+
+def dock_box(world: World) -> _Box:
+    """The dock's outline on the floor: a straight drive must keep off it as off a bench (a drive from
+    the dock's POI back past the dock ran the robot into it: layout seed 80006 at a22f3cf)."""
+    pose = world.dock_pose
+    x = pose.x - DOCK_BOX_BEHIND * math.cos(pose.yaw)
+    y = pose.y - DOCK_BOX_BEHIND * math.sin(pose.yaw)
+    return _Box(Pose2D(x, y, pose.yaw), (*DOCK_BOX, 0.0))
 
 
 class LayoutError(RuntimeError):
@@ -120,9 +142,10 @@ def _fits(raw: dict[str, Any], station: dict[str, Any], half: float) -> bool:
     for pose, clearance in standing:
         if any(bench_distance(other, pose.x, pose.y) < clearance for other in world.stations):
             return False
+    obstacles = [*world.stations, dock_box(world)]
     for i, start in enumerate(points):
         for end in points[i + 1 :]:
-            if any(_segment_gap(start, end, other) < CORRIDOR for other in world.stations):
+            if any(_segment_gap(start, end, other) < CORRIDOR for other in obstacles):
                 return False
     return True
 

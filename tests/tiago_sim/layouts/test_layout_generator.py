@@ -7,13 +7,15 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
 import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from labware_model.holders import Nest
+from tiago_sim.lab.serviceability import bench_distance
 from tiago_sim.lab.world import load_world
-from tiago_sim.layouts.generator import generate_layout
+from tiago_sim.layouts.generator import DOCK_BOX, DOCK_BOX_BEHIND, dock_box, generate_layout, layout_world
 from tiago_sim.layouts.layout_file import layout_yaml
 from tiago_sim.layouts.station_draw import LABWARE_TYPES, RANGES
 
@@ -66,3 +68,20 @@ def test_the_command_writes_a_layout_file_that_loads(tmp_path: Path) -> None:
     assert done.returncode == 0, done.stderr
     assert yaml.safe_load(target.read_text()) == generate_layout(11)
     assert load_world(target).name == "random layout 11"
+
+
+def test_the_dock_outline_is_the_scenes_dock_and_no_drive_between_pois_crosses_it() -> None:
+    from tiago_sim.physics import scene  # the test may look at the simulation; the generator may not
+
+    assert DOCK_BOX == scene.DOCK_SIZE[:2]
+    assert DOCK_BOX_BEHIND == pytest.approx(scene.BASE_RADIUS + scene.DOCK_GAP + scene.DOCK_SIZE[0] / 2)
+    for seed in (80006, *range(10)):  # 80006 drove through its dock before this rule (a22f3cf)
+        world = layout_world(seed)
+        points = [world.pois[world.dock_poi], *(station.work_pose() for station in world.stations)]
+        box = dock_box(world)
+        for i, start in enumerate(points):
+            for end in points[i + 1 :]:
+                steps = 40
+                dx, dy = (end.x - start.x) / steps, (end.y - start.y) / steps
+                gaps = [bench_distance(box, start.x + dx * k, start.y + dy * k) for k in range(steps + 1)]
+                assert min(gaps) >= 0.40 - 0.01, (seed, start, end)
