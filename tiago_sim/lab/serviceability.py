@@ -4,8 +4,12 @@ Why: a layout the robot cannot physically serve used to fail minutes into a run,
 at the bench (issue 14). These four checks refuse it before anything moves, from the robot model's
 geometry (tiago_sim.robot), each with its numbers:
 
-- footprint: the base (radius `BASE_RADIUS`) at a station's POI or working pose, or at the dock
-  and its POI, overlaps a bench;
+- footprint: the base (radius `BASE_RADIUS`) at the docked pose overlaps a bench; at a station's
+  working pose the hotel tray's turning circle (`HOTEL_SWEEP_RADIUS`) does: the final alignment
+  turns the base a few degrees there, and with the bench's edge 0.32 to 0.34 m ahead the tray
+  pressed the base into the bench with kilonewtons, shaking torso and head off their goals
+  (`Benchtop`, `Tuck`: "joints did not reach the goal ... head_1_joint", random layouts 80003,
+  80005, 80010 at 414b4a6);
 - turning room: the circle the onboard hotel tray sweeps when the base turns at a POI
   (`HOTEL_SWEEP_RADIUS` plus `TURN_MARGIN` for the navigation stop error) reaches a bench, its
   own or another station's (stations too close together);
@@ -116,7 +120,9 @@ def _station_problems(world, station) -> list[str]:  # noqa: ANN001
     for other in world.stations:
         turning = HOTEL_SWEEP_RADIUS + TURN_MARGIN
         problems += _clear(f"{station.name!r}: the base at POI {station.poi}", poi, turning, other)
-        problems += _clear(f"{station.name!r}: the base at the working pose", working, BASE_RADIUS, other)
+        problems += _clear(
+            f"{station.name!r}: the base at the working pose", working, HOTEL_SWEEP_RADIUS, other
+        )
     problems += _reach_problems(station, working)
     for label, pose in ((f"POI {station.poi}", poi), ("the working pose", working)):
         problems += _view_problems(station, label, pose)

@@ -27,6 +27,7 @@ RANGES: dict[str, Any] = {
     "marker_from_front_edge": (0.20, 0.30),  # m, bench front edge to marker
     "marker_above_top": (0.02, 0.08),  # m, the marker's lower edge above the bench top
     "nest_from_front_edge": (0.10, 0.15),  # m, bench front edge to nest centre; >= 0.08 m before the marker
+    # work_standoff: at least the nest's distance from the front edge + WORKING_EDGE
     "row_offset_from_marker": (-0.08, 0.08),  # m, the row's middle beside the marker, along it
     "clearance": (0.001, 0.002),  # m per side
     "approach_height": (0.10, 0.12),  # m
@@ -41,6 +42,7 @@ LABWARE_TYPES: dict[str, dict[str, float]] = {
 }
 NEST_HALF_EXTENT = 0.07  # m: half a plate's length plus the brackets' lead-in, along the row
 EDGE_MARGIN = 0.03  # m between a nest or the marker and the bench's side
+WORKING_EDGE = 0.36  # m: the loader's 0.35 m (the hotel tray's turning circle) and 1 cm for alignment
 
 
 def _between(rng: random.Random, key: str, digits: int = 3) -> float:
@@ -68,7 +70,10 @@ def draw_station(rng: random.Random, name: str, marker_id: int) -> dict[str, Any
     marker_low = max(-room + size / 2, -room + row / 2 + NEST_HALF_EXTENT + offset)
     marker_high = min(room - size / 2, room - row / 2 - NEST_HALF_EXTENT + offset)
     marker_y = round(rng.uniform(marker_low, marker_high), 3)
-    work = _between(rng, "work_standoff")
+    # the bench's front edge at least WORKING_EDGE ahead of the base at the working pose
+    work = round(
+        rng.uniform(max(RANGES["work_standoff"][0], nest_edge + WORKING_EDGE), RANGES["work_standoff"][1]), 3
+    )
     lateral_low, lateral_high = max(row / 2, 0.05), min(band - row / 2, 0.30)
     return {
         "name": name,

@@ -52,7 +52,7 @@ def test_a_working_pose_that_puts_the_base_inside_the_bench_is_refused(tmp_path:
     problems = refusal(tmp_path, close)
     assert any(
         "stations[0]: 'station_a': the base at the working pose" in line
-        and "from bench 'station_a'; its footprint needs 0.265 m" in line
+        and "from bench 'station_a'; the hotel tray's turning circle needs 0.350 m" in line
         for line in problems
     ), problems
 
