@@ -6,10 +6,10 @@ geometry (tiago_sim.robot), each with its numbers:
 
 - footprint: the base (radius `BASE_RADIUS`) at the docked pose overlaps a bench; at a station's
   working pose the hotel tray's turning circle (`HOTEL_SWEEP_RADIUS`) does: the final alignment
-  turns the base a few degrees there, and with the bench's edge 0.32 to 0.34 m ahead the tray
-  pressed the base into the bench with kilonewtons, shaking torso and head off their goals
-  (`Benchtop`, `Tuck`: "joints did not reach the goal ... head_1_joint", random layouts 80003,
-  80005, 80010 at 414b4a6);
+  turns the base a few degrees there. With bench edges 0.32 to 0.34 m ahead, `Benchtop`, `Tuck`
+  and `NestApproach` stopped with head or arm joints off their goals (random layouts 80003, 80005,
+  80010, 80019 at 414b4a6, reproducible with `bench --replay`); in a direct reproduction the base
+  link, which carries the tray, pressed into the bench with kilonewtons and shook torso and head;
 - turning room: the circle the onboard hotel tray sweeps when the base turns at a POI
   (`HOTEL_SWEEP_RADIUS` plus `TURN_MARGIN` for the navigation stop error) reaches a bench, its
   own or another station's (stations too close together);
