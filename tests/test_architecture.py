@@ -22,10 +22,12 @@ ALLOWED: dict[str, set[str]] = {
     "labware_model": set(),
     "tiago_sim.transforms": set(),
     "tiago_sim.node_main": set(),
-    "tiago_sim.lab": {"labware_model", "tiago_sim.transforms"},
+    "tiago_sim.lab": {"labware_model", "tiago_sim.transforms", "tiago_sim.robot"},
     "tiago_sim.robot": {"tiago_sim.transforms"},
     "tiago_sim.perception": {"tiago_sim.transforms"},
     "tiago_sim.navigation": {"labware_model", "tiago_sim.transforms", "tiago_sim.lab", "tiago_sim.robot"},
+    # random labs for campaigns: world files checked by the lab's loader
+    "tiago_sim.layouts": {"tiago_sim.transforms", "tiago_sim.lab", "tiago_sim.robot"},
     "tiago_sim.physics": {
         "labware_model",
         "tiago_sim.transforms",

@@ -132,6 +132,10 @@ class TrialOutcome:
     startup_wall_seconds: float
     plate_position_error_mm: float | None
     steps: list[dict[str, Any]] = field(default_factory=list)
+    world: str = ""  # the world file the trial ran in (a generated layout's, with --random-layouts)
+
+
+PORTS_PER_WORKER = 10  # SiLA ports a worker may use from its base: the robot's and up to 9 stations'
 
 
 @dataclass
@@ -141,14 +145,41 @@ class CampaignOptions:
     trials: int
     levels: dict[str, float]  # SI field name -> value in the flag's unit
     record_dir: Path | None = None  # frames of the first trial go here
+    jobs: int = 1  # trials run side by side, each worker with its own robot side, ports and ROS domain
+    layouts_dir: Path | None = None  # random layouts: trial seed S runs in layouts_dir/layout_S.yaml
 
 
-def run_trial(options: CampaignOptions, trial_seed: int, record_dir: Path | None = None) -> TrialOutcome:
-    """One fresh deployment, one standard transfer, stop. Never raises for a failed transfer."""
+def trial_stack(options: CampaignOptions, trial_seed: int, worker: int = 0) -> DeploymentOptions:
+    """The deployment of one trial: its world (the trial's random layout, or the campaign's), and the
+    worker's own SiLA ports and ROS domain (a requested domain id is shifted by the worker index)."""
     extra = ["--disturbance-seed", str(trial_seed), "--disturbance-levels", levels_json(options.levels)]
+    world = options.stack.world
+    if options.layouts_dir is not None:
+        world = layout_path(options.layouts_dir, trial_seed)
+    domain_id = options.stack.domain_id
+    return replace(
+        options.stack,
+        world=world,
+        extra_sim_arguments=extra,
+        port_base=options.stack.port_base + PORTS_PER_WORKER * worker,
+        domain_id=None if domain_id is None else domain_id + worker,
+    )
+
+
+def layout_path(layouts_dir: Path, trial_seed: int) -> Path:
+    return layouts_dir / f"layout_{trial_seed}.yaml"
+
+
+def run_trial(
+    options: CampaignOptions, trial_seed: int, record_dir: Path | None = None, worker: int = 0
+) -> TrialOutcome:
+    """One fresh deployment, one standard transfer, stop. Never raises for a failed transfer."""
+    stack = trial_stack(options, trial_seed, worker)
     if record_dir is not None:
-        extra += ["--record-dir", str(record_dir)]
-    deployment = Deployment(replace(options.stack, extra_sim_arguments=extra))
+        stack = replace(
+            stack, extra_sim_arguments=[*stack.extra_sim_arguments, "--record-dir", str(record_dir)]
+        )
+    deployment = Deployment(stack)
     started = time.monotonic()
     try:
         deployment.start()
@@ -170,6 +201,7 @@ def run_trial(options: CampaignOptions, trial_seed: int, record_dir: Path | None
         startup_wall_seconds=startup_s,
         plate_position_error_mm=report.plate_position_error_mm,
         steps=[asdict(step) for step in report.steps],
+        world=str(stack.world),
     )
 
 
@@ -226,16 +258,32 @@ def run_campaign(
                 trial_seed, len(outcomes), options.trials,
             )  # fmt: skip
             break
-        if not outcome.success:
-            logger.warning(
-                "trial seed %d failed (%s): %s; same disturbances again: sila-labware bench --replay %d",
-                trial_seed, outcome.cause, outcome.error, trial_seed,
-            )  # fmt: skip
-        outcomes.append(outcome)
-        progress.update(outcomes)
-        if on_trial is not None:
-            on_trial(outcome)
+        record_outcome(outcome, outcomes, progress, on_trial, replay_flags(options))
     return outcomes
+
+
+def replay_flags(options: CampaignOptions) -> str:
+    """What `bench --replay SEED` needs besides the seed to run a trial of this campaign again."""
+    return " --random-layouts" if options.layouts_dir is not None else ""
+
+
+def record_outcome(
+    outcome: TrialOutcome,
+    outcomes: list[TrialOutcome],
+    progress: CampaignProgress,
+    on_trial: Callable[[TrialOutcome], None] | None,
+    flags: str = "",
+) -> None:
+    """A finished trial: its failure logged with how to replay it, the progress shown, the callback."""
+    if not outcome.success:
+        logger.warning(
+            "trial seed %d failed (%s): %s; same disturbances again: sila-labware bench --replay %d%s",
+            outcome.seed, outcome.cause, outcome.error, outcome.seed, flags,
+        )  # fmt: skip
+    outcomes.append(outcome)
+    progress.update(outcomes)
+    if on_trial is not None:
+        on_trial(outcome)
 
 
 def _median(values: list[float]) -> float:
@@ -282,7 +330,9 @@ def summarize(outcomes: list[TrialOutcome], levels: dict[str, float], seed: int)
         "placement_error_mm_max": max(delivered, default=0.0),
         "phases": phases,
         "failed_trials": [
-            {"seed": o.seed, "cause": o.cause, "error": o.error} for o in outcomes if not o.success
+            {"seed": o.seed, "cause": o.cause, "error": o.error, "world": o.world}
+            for o in outcomes
+            if not o.success
         ],
         "levels": levels,
         "outcomes": [asdict(o) for o in outcomes],
@@ -316,6 +366,12 @@ def format_table(summary: dict[str, Any]) -> str:
         f"placement error of delivered plates: median {summary['placement_error_mm_median']:.1f} mm, "
         f"max {summary['placement_error_mm_max']:.1f} mm",
     ]
+    if "elapsed_wall_seconds" in summary and summary["trials"]:
+        elapsed = summary["elapsed_wall_seconds"]
+        lines.append(
+            f"elapsed: {elapsed:.0f} s for {summary['trials']} trial(s) on {summary['jobs']} worker(s), "
+            f"{elapsed / summary['trials']:.1f} s per trial"
+        )
     for failed in summary["failed_trials"]:
         lines.append(f"failed: seed {failed['seed']} ({failed['cause']}): {failed['error']}")
     return "\n".join(lines)

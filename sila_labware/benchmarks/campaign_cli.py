@@ -1,7 +1,9 @@
 """`sila-labware bench`: arguments and the command; `demo --record`: pictures of one run.
 
-    sila-labware bench --trials N --seed S [--world FILE] [--json] [--report DIR] [--replay SEED]
-                       [--level-scale X] [--nav-error-mm MM ...one flag per disturbance level]
+    sila-labware bench --trials N --seed S [--world FILE | --random-layouts] [--jobs N] [--json]
+                       [--report DIR] [--replay SEED] [--level-scale X]
+                       [--nav-error-mm MM ...one flag per disturbance level]
+    sila-labware bench --save-layout SEED FILE
 
 Exit codes: 0 every trial delivered its plate, 1 at least one failed, 2 bad usage, 130 stopped by
 Ctrl-C or SIGTERM (the trials done so far are still summarised). Threads: the CLI's main thread.
@@ -12,12 +14,16 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import os
 import sys
-from dataclasses import asdict
+import tempfile
+import time
+from dataclasses import asdict, replace
 from pathlib import Path
 
 from sila_labware.benchmarks.campaign import (
     LEVEL_FLAGS,
+    PORTS_PER_WORKER,
     CampaignOptions,
     TrialOutcome,
     format_table,
@@ -25,6 +31,13 @@ from sila_labware.benchmarks.campaign import (
     run_campaign,
     summarize,
 )
+from sila_labware.benchmarks.random_layouts import (
+    LayoutGenerationError,
+    generate_layouts,
+    keep_failed_layouts,
+    save_layout,
+)
+from sila_labware.benchmarks.workers import run_parallel_campaign
 from sila_labware.deployment.stack import DeploymentOptions
 
 logger = logging.getLogger(__name__)
@@ -50,6 +63,26 @@ def add_bench_arguments(bench: argparse.ArgumentParser) -> None:
         metavar="SEED",
         help=f"run the one trial with SEED again: {REPLAY_REPEATS}",
     )
+    bench.add_argument(
+        "--random-layouts",
+        action="store_true",
+        help="a new random lab per trial, drawn from the trial seed (--world is not used); "
+        "failed trials' world files are written next to the --report",
+    )
+    bench.add_argument(
+        "--save-layout",
+        nargs=2,
+        metavar=("SEED", "FILE"),
+        default=None,
+        help="write the random layout of trial seed SEED to FILE (for demo --world) and exit",
+    )
+    bench.add_argument(
+        "--jobs",
+        type=int,
+        default=len(os.sched_getaffinity(0)),  # the cores this process may run on
+        help="trials run side by side, each with its own robot side, SiLA ports (--port-base + 10 per "
+        "worker) and ROS domain (default: the cores, %(default)s)",
+    )
     bench.add_argument("--json", action="store_true", help="print one JSON object with the results")
     bench.add_argument(
         "--report", type=Path, default=None, metavar="DIR", help="write PNG charts and run pictures"
@@ -68,6 +101,14 @@ def add_bench_arguments(bench: argparse.ArgumentParser) -> None:
 def validate_bench(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
     if args.trials < 1:
         parser.error(f"--trials {args.trials}: need at least one")
+    if args.jobs < 1:
+        parser.error(f"--jobs {args.jobs}: need at least one")
+    if args.port_base + PORTS_PER_WORKER * args.jobs > 65535:
+        parser.error(f"--port-base {args.port_base} leaves no room for {args.jobs} workers' ports")
+    if args.save_layout is not None:
+        seed, _file = args.save_layout
+        if not seed.lstrip("-").isdigit():
+            parser.error(f"--save-layout {seed}: the seed is an integer")
     if args.level_scale < 0:
         parser.error("--level-scale must not be negative")
     for level in LEVEL_FLAGS:
@@ -87,17 +128,55 @@ def level_values(args: argparse.Namespace) -> dict[str, float]:
 
 def bench_command(args: argparse.Namespace, stack: DeploymentOptions) -> int:
     """Run the campaign (or one replayed trial), print the table or JSON, write the report."""
-    from sila_labware.benchmarks.campaign_report import write_charts, write_run_pictures
-
     if not args.verbose:
         # sila2 logs every failed command as a server-side traceback under loggers named after the
         # feature or command; the bench's own log (failures with their seeds) stays visible.
         logging.getLogger().setLevel(logging.CRITICAL)
         logging.getLogger("sila_labware").setLevel(logging.WARNING)
+    if args.save_layout is not None:
+        return save_layout_command(int(args.save_layout[0]), Path(args.save_layout[1]))
     levels = level_values(args)
     first_seed, trials = (args.replay, 1) if args.replay is not None else (args.seed, args.trials)
     frames_dir = args.report / "frames" if args.report is not None else None
-    options = CampaignOptions(stack, first_seed, trials, levels, record_dir=frames_dir)
+    # A trial's client connects to its servers by address: mDNS registration took 5 of a trial's
+    # 9 s start-up (measured), so a bench serves without discovery.
+    stack = replace(stack, discovery=False)
+    jobs = min(args.jobs, trials)
+    options = CampaignOptions(stack, first_seed, trials, levels, record_dir=frames_dir, jobs=jobs)
+    with tempfile.TemporaryDirectory(prefix="sila-labware-layouts-") as scratch:
+        if args.random_layouts:
+            try:
+                options.layouts_dir = draw_layouts(first_seed, trials, Path(scratch), jobs)
+            except LayoutGenerationError as error:
+                sys.stderr.write(f"bench: no random layouts: {error}\n")
+                return 1
+        return _run_and_report(args, options)
+
+
+def draw_layouts(first_seed: int, trials: int, directory: Path, jobs: int) -> Path:
+    """The campaign's random layouts, one per trial seed, written before the first trial."""
+    seeds = list(range(first_seed, first_seed + trials))
+    sys.stderr.write(f"bench: drawing {trials} random layout(s)\n")
+    generate_layouts(seeds, directory, jobs)
+    return directory
+
+
+def save_layout_command(seed: int, target: Path) -> int:
+    try:
+        save_layout(seed, target)
+    except LayoutGenerationError as error:
+        sys.stderr.write(f"bench: {error}\n")
+        return 1
+    sys.stdout.write(
+        f"{target}: random layout of seed {seed}; run it with sila-labware demo --world {target}\n"
+    )
+    return 0
+
+
+def _run_and_report(args: argparse.Namespace, options: CampaignOptions) -> int:
+    from sila_labware.benchmarks.campaign_report import write_charts, write_run_pictures
+
+    levels, first_seed, trials, frames_dir = options.levels, options.seed, options.trials, options.record_dir
     if args.replay is not None:
         sys.stderr.write(f"bench: replaying seed {first_seed}: {REPLAY_REPEATS}\n")
     else:
@@ -112,12 +191,21 @@ def bench_command(args: argparse.Namespace, stack: DeploymentOptions) -> int:
             with trials_log.open("a") as log_file:
                 log_file.write(json.dumps(asdict(outcome)) + "\n")
 
-    outcomes = run_campaign(options, progress_stream=sys.stderr, on_trial=on_trial)
+    run = run_campaign if options.jobs == 1 else run_parallel_campaign
+    started = time.monotonic()
+    outcomes = run(options, progress_stream=sys.stderr, on_trial=on_trial)
+    elapsed_s = time.monotonic() - started
+    kept = []
+    if args.report is not None and options.layouts_dir is not None:
+        kept = keep_failed_layouts(outcomes, args.report)  # the temporary layouts go with the run
     shown_levels = {level.flag.removeprefix("--"): levels[level.field] for level in LEVEL_FLAGS}
     summary = summarize(outcomes, shown_levels, first_seed)
+    summary["jobs"] = options.jobs
+    summary["random_layouts"] = options.layouts_dir is not None
+    summary["elapsed_wall_seconds"] = elapsed_s  # the trials' own, from the first start to the last stop
     if args.report is not None:
         written = write_charts(summary, args.report)
-        written += write_run_pictures(frames_dir, args.report)
+        written += write_run_pictures(frames_dir, args.report) + kept
         (args.report / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
         sys.stderr.write("report: " + ", ".join(str(path) for path in written) + "\n")
     interrupted = len(outcomes) < trials

@@ -29,6 +29,9 @@ from typing import IO
 
 logger = logging.getLogger(__name__)
 
+FASTDDS_PROFILE = Path(__file__).with_name("fastdds_profile.xml")
+"""Quick discovery: a deployment started in 2 s instead of 4 to 5 s (see the file)."""
+
 
 def ros_environment(domain_id: int, base: Mapping[str, str] | None = None) -> dict[str, str]:
     """The environment for ROS processes of one deployment: its own domain, this machine only."""
@@ -36,6 +39,7 @@ def ros_environment(domain_id: int, base: Mapping[str, str] | None = None) -> di
     environment["ROS_DOMAIN_ID"] = str(domain_id)
     environment.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
     environment.setdefault("RMW_IMPLEMENTATION", "rmw_fastrtps_cpp")
+    environment.setdefault("FASTRTPS_DEFAULT_PROFILES_FILE", str(FASTDDS_PROFILE))
     environment.setdefault("PYTHONUNBUFFERED", "1")
     return environment
 

@@ -104,7 +104,11 @@ def start_robot_side(
 def join_ros_domain(domain_id: int) -> None:
     """Put this process's own ROS participants (the bridge) into the deployment's domain."""
     os.environ.update(
-        {key: value for key, value in ros_environment(domain_id).items() if key.startswith(("ROS_", "RMW_"))}
+        {
+            key: value
+            for key, value in ros_environment(domain_id).items()
+            if key.startswith(("ROS_", "RMW_", "FASTRTPS_"))
+        }
     )
 
 

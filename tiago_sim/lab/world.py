@@ -43,6 +43,7 @@ __all__ = [
     "World",
     "WorldError",
     "load_world",
+    "world_from_raw",
 ]
 
 DEFAULT_WORLD = Path(__file__).resolve().parents[1] / "worlds" / "default.yaml"
@@ -175,9 +176,10 @@ class World:
         )
 
 
-def load_world(path: str | Path = DEFAULT_WORLD) -> World:
+def load_world(path: str | Path = DEFAULT_WORLD, *, check_robot: bool = True) -> World:
     """Read and validate a world file; raises WorldError listing every problem, each with the file and
-    the field."""
+    the field. `check_robot`: also refuse what the TIAGo++ cannot serve (`serviceability`: a bench
+    under the base or in the tray's turning circle, a nest out of reach, a marker out of view)."""
     source = str(path)
     try:
         raw = yaml.safe_load(Path(path).read_text())
@@ -185,13 +187,25 @@ def load_world(path: str | Path = DEFAULT_WORLD) -> World:
         raise WorldError([f"{source}: cannot read: {error}"]) from error
     except yaml.YAMLError as error:
         raise WorldError([f"{source}: not valid YAML: {' '.join(str(error).split())}"]) from error
+    return world_from_raw(raw, source, Path(path).stem, check_robot=check_robot)
+
+
+def world_from_raw(raw: Any, source: str, default_name: str = "lab", *, check_robot: bool = True) -> World:
+    """The checks of `load_world` on an already parsed file (a generated layout, say); `source` names
+    it in the messages."""
     model, problems = check(raw)
     if model is None:
         raise WorldError([problem.line(source) for problem in problems])
-    world = _world(model, source, default_name=Path(path).stem)
+    world = _world(model, source, default_name=default_name)
     placement = _obstacle_placement_problems(world)
     if placement:
         raise WorldError([f"{source}: {where}: {what}" for where, what in placement])
+    if check_robot:
+        from tiago_sim.lab.serviceability import service_problems  # pinocchio: only when checking
+
+        refused = service_problems(world)
+        if refused:
+            raise WorldError([f"{source}: {problem.where}: {problem.what}" for problem in refused])
     return world
 
 

@@ -110,8 +110,11 @@ class JointTrajectoryMotion(Motion):
         self.phase = "settling"
         self.settle_s += dt
         here = self.body.joint_positions()
-        error = float(np.max(np.abs(np.array([here[n] for n in self.names]) - self.points[-1])))
+        errors = np.abs(np.array([here[n] for n in self.names]) - self.points[-1])
+        error = float(np.max(errors))
         if error < SETTLE_TOLERANCE:
             self.finish(True)
         elif self.settle_s > SETTLE_TIMEOUT_S:
-            self.finish(False, "MOTION_FAILED", f"joints did not reach the goal (error {error:.3f})")
+            # the joint furthest off names the blocked part of the robot (rad; m for the torso)
+            worst = self.names[int(np.argmax(errors))]
+            self.finish(False, "MOTION_FAILED", f"joints did not reach the goal (error {error:.3f}, {worst})")

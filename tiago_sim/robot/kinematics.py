@@ -17,10 +17,12 @@ from functools import lru_cache
 import numpy as np
 import pinocchio as pin
 
+from tiago_sim import transforms as tf
 from tiago_sim.robot import robot_model
 
 log = logging.getLogger(__name__)
 
+CAMERA_FRAME = "head_camera_optical_frame"
 IK_DAMPING = 1e-3
 IK_POSITION_TOLERANCE = 5e-4  # m
 IK_ORIENTATION_TOLERANCE = 2e-3  # rad
@@ -182,3 +184,19 @@ def top_down_grasp(position: np.ndarray, yaw: float) -> np.ndarray:
     transform[:3, :3] = np.column_stack([x_axis, y_axis, z_axis])
     transform[:3, 3] = position
     return transform
+
+
+def head_angles_towards(kinematics: RobotKinematics, joints: dict[str, float], target: np.ndarray) -> dict:
+    """Pan and tilt that point the head at `target` (base_footprint), from the head joint origins."""
+    level = {**joints, "head_1_joint": 0.0, "head_2_joint": 0.0}
+    pan_origin = kinematics.forward(level, "head_1_link")[:3, 3]
+    pan = math.atan2(target[1] - pan_origin[1], target[0] - pan_origin[0])
+    tilt_origin = kinematics.forward({**level, "head_1_joint": pan}, "head_2_link")[:3, 3]
+    horizontal = math.hypot(target[0] - tilt_origin[0], target[1] - tilt_origin[1])
+    tilt = -math.atan2(tilt_origin[2] - target[2], horizontal)  # negative tilt looks down
+    for _ in range(3):  # the camera sits off both head axes: centre the target in the image
+        optical = kinematics.forward({**level, "head_1_joint": pan, "head_2_joint": tilt}, CAMERA_FRAME)
+        x, y, z = tf.invert(optical)[:3, :3] @ (target - optical[:3, 3])  # z ahead, x right, y down
+        pan -= math.atan2(x, z)
+        tilt -= math.atan2(y, z)
+    return {"head_1_joint": pan, "head_2_joint": tilt}

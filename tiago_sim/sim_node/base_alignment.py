@@ -26,32 +26,15 @@ from labware_interfaces.msg import ErrorCodes
 
 from tiago_sim import transforms as tf
 from tiago_sim.lab.world import Station
-from tiago_sim.robot.kinematics import RobotKinematics
+from tiago_sim.robot.kinematics import RobotKinematics, head_angles_towards
 from tiago_sim.sim_node.action_run import ActionAbort, ActionRun
 
 log = logging.getLogger(__name__)
 
 HEAD_JOINTS = ("head_1_joint", "head_2_joint")
-CAMERA_FRAME = "head_camera_optical_frame"
 # rad; the camera sees 63 deg across. The second look repeats the first once the torso stands.
 SEARCH_PAN_OFFSETS = (0.0, 0.0, 0.45, -0.45, 0.9, -0.9)
 ALIGN_SPEED = 0.3  # m/s cap for the short final drive (the acceleration limit keeps it lower anyway)
-
-
-def head_angles_towards(kinematics: RobotKinematics, joints: dict[str, float], target: np.ndarray) -> dict:
-    """Pan and tilt that point the head at `target` (base_footprint), from the head joint origins."""
-    level = {**joints, "head_1_joint": 0.0, "head_2_joint": 0.0}
-    pan_origin = kinematics.forward(level, "head_1_link")[:3, 3]
-    pan = math.atan2(target[1] - pan_origin[1], target[0] - pan_origin[0])
-    tilt_origin = kinematics.forward({**level, "head_1_joint": pan}, "head_2_link")[:3, 3]
-    horizontal = math.hypot(target[0] - tilt_origin[0], target[1] - tilt_origin[1])
-    tilt = -math.atan2(tilt_origin[2] - target[2], horizontal)  # negative tilt looks down
-    for _ in range(3):  # the camera sits off both head axes: centre the target in the image
-        optical = kinematics.forward({**level, "head_1_joint": pan, "head_2_joint": tilt}, CAMERA_FRAME)
-        x, y, z = tf.invert(optical)[:3, :3] @ (target - optical[:3, 3])  # z ahead, x right, y down
-        pan -= math.atan2(x, z)
-        tilt -= math.atan2(y, z)
-    return {"head_1_joint": pan, "head_2_joint": tilt}
 
 
 def planar(transform: np.ndarray) -> tuple[float, float, float]:

@@ -21,7 +21,13 @@ import cv2
 import numpy as np
 import pytest
 
-from sila_labware.benchmarks.campaign import CAUSES, LEVEL_FLAGS, classify_failure, levels_json
+from sila_labware.benchmarks.campaign import (
+    CAUSES,
+    LEVEL_FLAGS,
+    PORTS_PER_WORKER,
+    classify_failure,
+    levels_json,
+)
 from sila_labware.deployment.demo import DemoReport
 from tests.helpers.sila_stack import free_port_base
 from tiago_sim.lab.world import load_world
@@ -35,7 +41,7 @@ def run_bench(*arguments: str, timeout_s: float = 240.0) -> subprocess.Completed
     """`bench` as a user runs it. Past `timeout_s` (inside pytest's 300 s) it is stopped as Ctrl-C
     would, so its robot side is stopped too, and the test fails with what it printed (a run hung
     once in CI, and SIGKILL had lost its output)."""
-    stack = ["--insecure", "--no-discovery", "--port-base", str(free_port_base(4))]
+    stack = ["--insecure", "--no-discovery", "--port-base", str(free_port_base(2 * PORTS_PER_WORKER))]
     command = [*CLI, "bench", *stack, *arguments]
     with subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as bench:
         try:
@@ -206,7 +212,7 @@ def test_sigterm_stops_the_campaign_its_robot_side_and_summarises_what_was_done(
     temp_dir = tmp_path / "tmp"
     temp_dir.mkdir()
     bench = subprocess.Popen(
-        [*CLI, "bench", *stack, "--trials", "3", "--seed", str(SEED), "--json"],
+        [*CLI, "bench", *stack, "--trials", "3", "--seed", str(SEED), "--json", "--jobs", "1"],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,

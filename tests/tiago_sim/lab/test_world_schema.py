@@ -326,7 +326,7 @@ def test_optional_keys_take_their_documented_defaults(tmp_path: Path) -> None:
             item["nests"].pop(key)
         for key in ("work_standoff", "lateral"):
             item["poi"].pop(key)
-    world = load_world(write(tmp_path, data))
+    world = load_world(write(tmp_path, data), check_robot=False)  # defaults, not a servable lab
     assert (world.name, world.floor_size, world.hotel_slots, dict(world.plates)) == ("lab", 12.0, 2, {})
     assert world.start_docked and set(world.pois) == {"dock_approach", "station_a_work", "station_b_work"}
     assert world.pois["dock_approach"].x == pytest.approx(data["dock"]["pose"][0] + 0.6)

@@ -1,0 +1,80 @@
+"""The loader refuses what the TIAGo++ cannot serve, before anything moves: one test per reason,
+each an edit of the default lab that breaks exactly one thing, and the message names the file, the
+station and the numbers. The shipped worlds all pass (they are served in the deployment tests)."""
+
+from __future__ import annotations
+
+import copy
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import pytest
+import yaml
+
+from tiago_sim.lab.world import WorldError, load_world
+from tiago_sim.lab.world_schema import SCHEMA_FILE
+
+DEFAULT = yaml.safe_load((SCHEMA_FILE.parent / "default.yaml").read_text())
+
+
+def refusal(tmp_path: Path, change: Callable[[dict[str, Any]], Any]) -> list[str]:
+    data = copy.deepcopy(DEFAULT)
+    change(data)
+    path = tmp_path / "lab.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    with pytest.raises(WorldError) as refused:
+        load_world(path)
+    assert all(line.startswith(f"{path}: ") for line in refused.value.problems)
+    return list(refused.value.problems)
+
+
+@pytest.mark.parametrize("world", sorted(SCHEMA_FILE.parent.glob("*.yaml")), ids=lambda p: p.name)
+def test_every_shipped_world_passes_the_robot_checks(world: Path) -> None:
+    load_world(world)
+
+
+def test_a_nest_above_the_arms_reach_at_any_torso_height_is_refused(tmp_path: Path) -> None:
+    def high_bench(data: dict[str, Any]) -> None:
+        data["stations"][1]["table"]["size"][2] = 1.10
+
+    problems = refusal(tmp_path, high_bench)
+    reach = [line for line in problems if "reach" in line]
+    assert reach and "stations[1]: 'station_b': nest 1 is out of the right arm's reach" in reach[0]
+    assert "z 1.100 m" in reach[0]
+    assert not any("stations[0]" in line for line in problems)
+
+
+def test_a_working_pose_that_puts_the_base_inside_the_bench_is_refused(tmp_path: Path) -> None:
+    def close(data: dict[str, Any]) -> None:
+        data["stations"][0]["poi"]["work_standoff"] = 0.30
+
+    problems = refusal(tmp_path, close)
+    assert any(
+        "stations[0]: 'station_a': the base at the working pose" in line
+        and "from bench 'station_a'; the hotel tray's turning circle needs 0.350 m" in line
+        for line in problems
+    ), problems
+
+
+def test_stations_too_close_for_the_hotel_tray_to_turn_are_refused(tmp_path: Path) -> None:
+    def neighbour(data: dict[str, Any]) -> None:  # station_b's bench beside station_a's POI
+        poi = load_world(SCHEMA_FILE.parent / "default.yaml").station("station_a").work_pose()
+        data["stations"][1]["table"]["pose"] = [poi.x, poi.y + 0.80, 0.0]
+
+    problems = refusal(tmp_path, neighbour)
+    turning = [line for line in problems if "turning circle" in line and "stations[0]" in line]
+    assert turning and "POI station_a_work" in turning[0] and "bench 'station_b'" in turning[0], problems
+    assert "needs 0.400 m" in turning[0]
+
+
+def test_a_marker_the_head_camera_cannot_see_from_the_poi_is_refused(tmp_path: Path) -> None:
+    def lying_flat(data: dict[str, Any]) -> None:  # a marker lying on the bench, face up
+        data["stations"][0]["marker"]["rpy"] = [0, 0, -90]
+        data["stations"][0]["nests"]["site_in_marker_rpy"] = [0, 0, 0]
+        data["stations"][0]["nests"]["site_in_marker_xyz"] = [-0.085, -0.13, -0.09]
+
+    problems = refusal(tmp_path, lying_flat)
+    view = [line for line in problems if "cannot see marker 3 from POI station_a_work" in line]
+    assert view and "off its face's normal (at most 60)" in view[0], problems
+    assert not any("reach" in line for line in problems)

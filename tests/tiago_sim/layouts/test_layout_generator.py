@@ -1,0 +1,87 @@
+"""The layout generator: every layout it draws passes the loader (robot checks included), stays in
+its documented ranges, keeps the demo transfer possible, and is the same for the same seed."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from labware_model.holders import Nest
+from tiago_sim.lab.serviceability import bench_distance
+from tiago_sim.lab.world import load_world
+from tiago_sim.layouts.generator import DOCK_BOX, DOCK_BOX_BEHIND, dock_box, generate_layout, layout_world
+from tiago_sim.layouts.layout_file import layout_yaml
+from tiago_sim.layouts.station_draw import LABWARE_TYPES, RANGES
+
+REPOSITORY = Path(__file__).resolve().parents[3]
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(seed=st.integers(min_value=0, max_value=2**31 - 1))
+def test_every_generated_layout_loads_and_stays_in_its_ranges(tmp_path: Path, seed: int) -> None:
+    path = tmp_path / f"layout_{seed}.yaml"
+    path.write_text(layout_yaml(seed))
+    world = load_world(path)  # the file's rules and the robot checks
+    low, high = RANGES["stations"]
+    assert low <= len(world.stations) <= high
+    for station in world.stations:
+        assert RANGES["nests"][0] <= station.sub_positions <= RANGES["nests"][1]
+        assert RANGES["bench_height"][0] <= station.table_size[2] <= RANGES["bench_height"][1]
+        assert RANGES["marker_size"][0] <= station.marker_size <= RANGES["marker_size"][1]
+        for sub_position in range(1, station.sub_positions + 1):  # every nest floor on the bench top
+            assert abs(station.T_world_site(sub_position)[2, 3] - station.table_size[2]) < 1e-9
+    source, destination = world.stations[0], world.stations[1]
+    holders = set(world.plates.values())
+    assert any(isinstance(h, Nest) and h.station == source.name for h in holders)
+    assert any(nest not in holders for nest in destination.nests())
+    assert set(world.labware_types) == set(LABWARE_TYPES)
+
+
+def test_the_same_seed_gives_the_same_layout_and_another_seed_another() -> None:
+    assert layout_yaml(7) == layout_yaml(7)
+    assert layout_yaml(7) != layout_yaml(8)
+
+
+def test_forty_layouts_cover_headings_nest_counts_and_both_plate_types() -> None:
+    layouts = [generate_layout(seed) for seed in range(40)]
+    stations = [station for layout in layouts for station in layout["stations"]]
+    headings = {int(station["table"]["pose"][2] // 90) for station in stations}  # the four quadrants
+    assert headings == {-2, -1, 0, 1}
+    assert {station["nests"]["sub_positions"] for station in stations} == {1, 2, 3, 4}
+    assert {len(layout["stations"]) for layout in layouts} == set(range(2, 7))
+    moved_types = {layout["plates"][0]["type"] for layout in layouts}
+    assert moved_types == set(LABWARE_TYPES)
+
+
+def test_the_command_writes_a_layout_file_that_loads(tmp_path: Path) -> None:
+    target = tmp_path / "lab.yaml"
+    done = subprocess.run(
+        [sys.executable, "-m", "tiago_sim.layouts", "11", "--file", str(target)],
+        cwd=REPOSITORY, capture_output=True, text=True, timeout=120, check=False,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert yaml.safe_load(target.read_text()) == generate_layout(11)
+    assert load_world(target).name == "random layout 11"
+
+
+def test_the_dock_outline_is_the_scenes_dock_and_no_drive_between_pois_crosses_it() -> None:
+    from tiago_sim.physics import scene  # the test may look at the simulation; the generator may not
+
+    assert DOCK_BOX == scene.DOCK_SIZE[:2]
+    assert DOCK_BOX_BEHIND == pytest.approx(scene.BASE_RADIUS + scene.DOCK_GAP + scene.DOCK_SIZE[0] / 2)
+    for seed in (80006, *range(10)):  # 80006 drove through its dock before this rule (a22f3cf)
+        world = layout_world(seed)
+        points = [world.pois[world.dock_poi], *(station.work_pose() for station in world.stations)]
+        box = dock_box(world)
+        for i, start in enumerate(points):
+            for end in points[i + 1 :]:
+                steps = 40
+                dx, dy = (end.x - start.x) / steps, (end.y - start.y) / steps
+                gaps = [bench_distance(box, start.x + dx * k, start.y + dy * k) for k in range(steps + 1)]
+                assert min(gaps) >= 0.40 - 0.01, (seed, start, end)

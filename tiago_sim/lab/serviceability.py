@@ -1,0 +1,190 @@
+"""Can the TIAGo++ serve this lab? The checks the loader runs after the file's own rules.
+
+Why: a layout the robot cannot physically serve used to fail minutes into a run, as a motion error
+at the bench (issue 14). These four checks refuse it before anything moves, from the robot model's
+geometry (tiago_sim.robot), each with its numbers:
+
+- footprint: the base (radius `BASE_RADIUS`) at the docked pose overlaps a bench; at a station's
+  working pose the hotel tray's turning circle (`HOTEL_SWEEP_RADIUS`) does: the final alignment
+  turns the base a few degrees there. With bench edges 0.32 to 0.34 m ahead, `Benchtop`, `Tuck`
+  and `NestApproach` stopped with head or arm joints off their goals (random layouts 80003, 80005,
+  80010, 80019 at 414b4a6, reproducible with `bench --replay`); in a direct reproduction the base
+  link, which carries the tray, pressed into the bench with kilonewtons and shook torso and head;
+- turning room: the circle the onboard hotel tray sweeps when the base turns at a POI
+  (`HOTEL_SWEEP_RADIUS` plus `TURN_MARGIN` for the navigation stop error) reaches a bench, its
+  own or another station's (stations too close together);
+- reach: no torso height and right-arm configuration puts the grasping frame top-down on a nest
+  (grasp and approach height, either finger order), IK on the pinocchio model from the working pose;
+- marker view: from the POI and from the working pose, the head camera aimed at the marker cannot
+  see it: pan or tilt beyond the head's limits, too near or too far, seen too obliquely, or too small
+  in the image.
+
+Pure computation (pinocchio, numpy); safe on any thread that owns its own `RobotKinematics`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from tiago_sim import transforms as tf
+from tiago_sim.robot import robot_model
+from tiago_sim.robot.kinematics import CAMERA_FRAME, RobotKinematics, head_angles_towards
+from tiago_sim.robot.motion_library import HotelGrasp, load_motions
+
+BASE_RADIUS = robot_model.BASE_RADIUS
+HOTEL_SWEEP_RADIUS = 0.35
+"""The onboard hotel tray's farthest corner from the base centre (m): the circle a turn sweeps."""
+TURN_MARGIN = 0.05
+"""Navigation stops up to a few cm off its POI (30 mm per axis, one sigma, by default)."""
+REACH_ARM = "right"
+LOOK_TORSO_LIFT = 0.15
+"""The torso height of "Home", where the first look at a station's marker is taken (m)."""
+CAMERA_FOCAL_PX = 522.2
+MARKER_DISTANCE_RANGE = (0.4, 1.6)
+"""Camera to marker centre (m): the camera clips at 0.3 m; beyond 1.5 to 2.5 m detection failed."""
+MARKER_MAX_OBLIQUITY_DEG = 60.0
+"""Angle between the marker's normal and the line to the camera; ArUco corners blur beyond this."""
+MARKER_MIN_PIXELS = 40.0
+"""Side of the black square in the 640 x 480 image; the pose error grows fast below this."""
+_FLIP_ABOUT_APPROACH = tf.make_transform(rotation=np.diag([1.0, -1.0, -1.0]))
+
+
+@dataclass(frozen=True)
+class ServiceProblem:
+    """A station (index, or -1 for the dock) the robot cannot serve, and why with the numbers."""
+
+    station_index: int
+    what: str
+
+    @property
+    def where(self) -> str:
+        return "dock" if self.station_index < 0 else f"stations[{self.station_index}]"
+
+
+@lru_cache(maxsize=1)
+def _robot() -> tuple[RobotKinematics, HotelGrasp, dict[str, float]]:
+    motions = load_motions()
+    seed: dict[str, float] = {}
+    for frame in motions.frames_for("Benchtop", REACH_ARM):
+        seed.update(frame)
+    return RobotKinematics(), motions.hotel, seed
+
+
+def service_problems(world) -> list[ServiceProblem]:  # noqa: ANN001 - a lab.world.World (no import cycle)
+    """Every reason the robot cannot serve `world`, station by station (empty: it can)."""
+    problems = list(_footprint_problems(world))
+    for index, station in enumerate(world.stations):
+        problems += [ServiceProblem(index, what) for what in _station_problems(world, station)]
+    problems.sort(key=lambda problem: problem.station_index)
+    return problems
+
+
+def bench_distance(station, x: float, y: float) -> float:  # noqa: ANN001
+    """Distance (m) from floor point (x, y) to the station's bench outline; negative inside it."""
+    pose = station.table_pose
+    c, s = math.cos(pose.yaw), math.sin(pose.yaw)
+    dx, dy = x - pose.x, y - pose.y
+    depth, width = station.table_size[0], station.table_size[1]
+    local = (abs(c * dx + s * dy) - depth / 2, abs(-s * dx + c * dy) - width / 2)
+    outside = math.hypot(max(local[0], 0.0), max(local[1], 0.0))
+    return outside if outside > 0 else max(local)
+
+
+def _footprint_problems(world) -> Iterator[ServiceProblem]:  # noqa: ANN001
+    dock_poses = (("the docked pose", world.dock_pose, BASE_RADIUS),)
+    dock_poi = world.pois[world.dock_poi]
+    dock_poses += ((f"POI {world.dock_poi}", dock_poi, HOTEL_SWEEP_RADIUS + TURN_MARGIN),)
+    for label, pose, radius in dock_poses:
+        for station in world.stations:
+            yield from (ServiceProblem(-1, what) for what in _clear(label, pose, radius, station))
+
+
+def _clear(label: str, pose, radius: float, station) -> Iterator[str]:  # noqa: ANN001
+    gap = bench_distance(station, pose.x, pose.y)
+    if gap < radius:
+        need = "its footprint" if radius == BASE_RADIUS else "the hotel tray's turning circle"
+        yield (
+            f"{label} at x {pose.x:.3f} y {pose.y:.3f} m is {gap:.3f} m from bench {station.name!r}; "
+            f"{need} needs {radius:.3f} m"
+        )
+
+
+def _station_problems(world, station) -> list[str]:  # noqa: ANN001
+    poi, working = station.work_pose(), station.aligned_pose()
+    problems: list[str] = []
+    for other in world.stations:
+        turning = HOTEL_SWEEP_RADIUS + TURN_MARGIN
+        problems += _clear(f"{station.name!r}: the base at POI {station.poi}", poi, turning, other)
+        problems += _clear(
+            f"{station.name!r}: the base at the working pose", working, HOTEL_SWEEP_RADIUS, other
+        )
+    problems += _reach_problems(station, working)
+    for label, pose in ((f"POI {station.poi}", poi), ("the working pose", working)):
+        problems += _view_problems(station, label, pose)
+    return problems
+
+
+def _reach_problems(station, working) -> list[str]:  # noqa: ANN001
+    kinematics, grasp, seed = _robot()
+    T_base_world = tf.invert(working.matrix())
+    problems = []
+    for sub_position in range(1, station.sub_positions + 1):
+        T_base_site = tf.levelled(T_base_world @ station.T_world_site(sub_position))
+        heights = (("the grasp", 0.0), ("the approach", station.approach_height))
+        for label, height in heights:
+            T_base_grasp = T_base_site @ tf.make_transform((0.0, 0.0, height)) @ grasp.T_slot_grasp(False)
+            if not _reachable(kinematics, T_base_grasp, seed):
+                x, y, z = T_base_site[:3, 3]
+                problems.append(
+                    f"{station.name!r}: nest {sub_position} is out of the {REACH_ARM} arm's reach at "
+                    f"any torso height ({label}, {height * 1000:.0f} mm above the nest: x {x:.3f} y {y:.3f} "
+                    f"z {z:.3f} m in the working pose's base_footprint)"
+                )
+                break
+    return problems
+
+
+def _reachable(kinematics: RobotKinematics, T_base_grasp: np.ndarray, seed: dict[str, float]) -> bool:
+    for twin in (T_base_grasp, T_base_grasp @ _FLIP_ABOUT_APPROACH):
+        if kinematics.inverse(REACH_ARM, twin, seed, use_torso=True, restarts=20).success:
+            return True
+    return False
+
+
+def _view_problems(station, label: str, pose) -> list[str]:  # noqa: ANN001
+    kinematics, _grasp, _seed = _robot()
+    T_base_marker = tf.invert(pose.matrix()) @ station.T_world_marker()
+    target = T_base_marker[:3, 3]
+    aim = head_angles_towards(kinematics, {"torso_lift_joint": LOOK_TORSO_LIFT}, target)
+    pan, tilt = aim["head_1_joint"], aim["head_2_joint"]
+    head = {joint.name: joint.limits_deg for joint in robot_model.HEAD_JOINTS}
+    joints = {"torso_lift_joint": LOOK_TORSO_LIFT, "head_1_joint": pan, "head_2_joint": tilt}
+    camera = kinematics.forward(joints, CAMERA_FRAME)[:3, 3]
+    to_camera = camera - target
+    distance = float(np.linalg.norm(to_camera))
+    obliquity = math.degrees(math.acos(np.clip(T_base_marker[:3, 2] @ to_camera / distance, -1.0, 1.0)))
+    pixels = CAMERA_FOCAL_PX * station.marker_size / distance
+    reasons = []
+    for name, angle in (("head_1", pan), ("head_2", tilt)):
+        low, high = head[name]
+        if not low <= math.degrees(angle) <= high:
+            reasons.append(f"{name} would need {math.degrees(angle):.0f} deg (limits {low:g} .. {high:g})")
+    if not MARKER_DISTANCE_RANGE[0] <= distance <= MARKER_DISTANCE_RANGE[1]:
+        low, high = MARKER_DISTANCE_RANGE
+        reasons.append(f"the marker is {distance:.2f} m from the camera (usable {low:g} .. {high:g} m)")
+    if obliquity > MARKER_MAX_OBLIQUITY_DEG:
+        reasons.append(
+            f"the marker is seen {obliquity:.0f} deg off its face's normal "
+            f"(at most {MARKER_MAX_OBLIQUITY_DEG:g})"
+        )
+    elif pixels < MARKER_MIN_PIXELS:
+        reasons.append(f"the marker is {pixels:.0f} px wide in the image (at least {MARKER_MIN_PIXELS:g})")
+    if not reasons:
+        return []
+    seeing = f"{station.name!r}: the head camera cannot see marker {station.marker_id} from {label}"
+    return [f"{seeing}: " + "; ".join(reasons)]

@@ -1,0 +1,1 @@
+"""Random labs for campaigns over layouts the robot was never tuned on (README "Random layouts")."""

@@ -1,0 +1,208 @@
+"""Random labs the TIAGo++ can serve, one per seed: the world files a campaign over unseen layouts runs.
+
+Why: the robot was tuned on one lab; a lab integrator writes their own file. A layout drawn here
+varies everything the world file lets them choose, within the schema's ranges and what the robot
+can physically serve (`RANGES`, README "Random layouts"), and every layout passes the loader,
+robot checks included (`tiago_sim.lab.serviceability`). Same seed, same layout (Python's
+`random.Random`, no global state); the result is the world file's mapping, ready for YAML.
+
+Drawn per layout: 2 to 6 stations anywhere on the floor at any heading, the dock anywhere; per
+station the bench's depth, width and height, the marker's id, size and place on its stand, 1 to 4
+nests at a spacing, their place in front of the marker, the approach height and clearance, the
+working distance and the lateral offset that puts the row on the right arm's side. The plate to
+move starts on any nest of the first station; other plates occupy other nests (the second station
+keeps a free one, the transfer's destination) and sometimes hotel slot 2. Labware types: a 96-well
+microplate and a 96-well deep-well plate, both SBS footprint.
+
+Layout rules beyond the loader's: everything stays 0.3 m inside the floor's walls, and the straight
+drives between the dock's POI and the stations' POIs keep the hotel tray's turning circle
+(0.40 m) off every bench and the dock, since navigation drives straight from POI to POI today.
+Pure; any thread.
+"""
+
+from __future__ import annotations
+
+import math
+import random
+from dataclasses import dataclass
+from typing import Any
+
+from tiago_sim.lab.serviceability import BASE_RADIUS, HOTEL_SWEEP_RADIUS, TURN_MARGIN, bench_distance
+from tiago_sim.lab.world import Pose2D, World, WorldError, world_from_raw
+from tiago_sim.lab.world_schema import MARKER_DICTIONARY_SIZE, MIRROR_AMBIGUOUS_MARKER_IDS
+from tiago_sim.layouts.station_draw import LABWARE_TYPES, RANGES, draw_station
+
+STATION_NAMES = ("reader", "sealer", "incubator", "washer", "dispenser", "centrifuge", "labeler", "storage")
+MARKER_IDS = tuple(i for i in range(MARKER_DICTIONARY_SIZE) if i not in MIRROR_AMBIGUOUS_MARKER_IDS)
+WALL_MARGIN = 0.3  # m between anything the robot uses and the floor's edge (walls 0.1 m thick)
+CORRIDOR = HOTEL_SWEEP_RADIUS + TURN_MARGIN
+WORKING_CLEARANCE = HOTEL_SWEEP_RADIUS + 0.01  # the base at a working pose, from every bench
+PLACEMENT_TRIES = 300  # per station, before the whole floor is drawn again
+LAYOUT_TRIES = 50
+
+
+DOCK_BOX = (0.10, 0.45)  # m, the dock's footprint (tiago_sim.physics.scene.DOCK_SIZE)
+DOCK_BOX_BEHIND = BASE_RADIUS + 0.002 + DOCK_BOX[0] / 2  # its centre behind the docked base's centre
+
+
+@dataclass(frozen=True)
+class _Box:
+    """An obstacle's outline as `bench_distance` reads a station's: pose of its centre, depth, width."""
+
+    table_pose: Pose2D
+    table_size: tuple[float, float, float]
+
+
+def dock_box(world: World) -> _Box:
+    """The dock's outline on the floor: a straight drive must keep off it as off a bench (a drive from
+    the dock's POI back past the dock ran the robot into it: layout seed 80006 at a22f3cf)."""
+    pose = world.dock_pose
+    x = pose.x - DOCK_BOX_BEHIND * math.cos(pose.yaw)
+    y = pose.y - DOCK_BOX_BEHIND * math.sin(pose.yaw)
+    return _Box(Pose2D(x, y, pose.yaw), (*DOCK_BOX, 0.0))
+
+
+class LayoutError(RuntimeError):
+    """The generator found no valid layout for a seed (its ranges would be too narrow)."""
+
+
+def generate_layout(seed: int) -> dict[str, Any]:
+    """The world file (a mapping) of the random lab with this seed; it passes `load_world`."""
+    rng = random.Random(seed)
+    problems: list[str] = []
+    for _ in range(LAYOUT_TRIES):
+        raw = _draw_layout(rng, seed)
+        if raw is None:
+            continue
+        try:
+            world_from_raw(raw, f"layout seed {seed}")
+        except WorldError as error:  # a check the drawing does not foresee: draw again
+            problems = list(error.problems)
+            continue
+        return raw
+    raise LayoutError(f"no valid layout for seed {seed} in {LAYOUT_TRIES} tries; last: {problems[:3]}")
+
+
+def layout_world(seed: int) -> World:
+    """The generated lab as the program reads it."""
+    return world_from_raw(generate_layout(seed), f"layout seed {seed}", f"layout_{seed}")
+
+
+def _draw_layout(rng: random.Random, seed: int) -> dict[str, Any] | None:
+    count = rng.randint(*RANGES["stations"])
+    floor = round(rng.uniform(*RANGES["floor_size"]) + 0.5 * count, 1)
+    half = floor / 2 - WALL_MARGIN
+    dock_pose = [
+        round(rng.uniform(-half + 0.4, half - 0.4), 2),
+        round(rng.uniform(-half + 0.4, half - 0.4), 2),
+    ]
+    dock_pose.append(float(rng.randrange(-180, 180)))
+    dock = {"pose": dock_pose, "poi": "dock_approach", "approach_distance": round(rng.uniform(0.5, 0.8), 2)}
+    names = rng.sample(STATION_NAMES, count)
+    marker_ids = rng.sample(MARKER_IDS, count)
+    stations: list[dict[str, Any]] = []
+    raw = {
+        "name": f"random layout {seed}",
+        "floor_size": floor,
+        "dock": dock,
+        "robot": {"start": "docked", "hotel_slots": 2},
+        "labware_types": {name: dict(sizes) for name, sizes in LABWARE_TYPES.items()},
+        "stations": stations,
+        "plates": [],
+    }
+    for name, marker_id in zip(names, marker_ids, strict=True):
+        station = draw_station(rng, name, marker_id)
+        for _ in range(PLACEMENT_TRIES):
+            pose = [round(rng.uniform(-half, half), 2), round(rng.uniform(-half, half), 2)]
+            station["table"]["pose"] = [*pose, float(rng.randrange(-180, 180))]
+            if _fits(raw, station, half):
+                break
+        else:
+            return None
+        stations.append(station)
+    raw["plates"] = _plates(rng, stations)
+    return raw
+
+
+def _fits(raw: dict[str, Any], station: dict[str, Any], half: float) -> bool:
+    """The new station inside the floor, clear of the others and of every straight drive."""
+    candidate = {**raw, "stations": [*raw["stations"], station]}
+    try:
+        world = world_from_raw(candidate, "layout", check_robot=False)
+    except WorldError:
+        return False
+    new = world.stations[-1]
+    corners = _bench_corners(new)
+    if any(abs(c) > half for corner in corners for c in corner):
+        return False
+    points = [world.pois[world.dock_poi], *(s.work_pose() for s in world.stations)]
+    if any(abs(p.x) > half - CORRIDOR or abs(p.y) > half - CORRIDOR for p in points):
+        return False
+    standing = [(world.dock_pose, CORRIDOR), *((s.aligned_pose(), WORKING_CLEARANCE) for s in world.stations)]
+    for pose, clearance in standing:
+        if any(bench_distance(other, pose.x, pose.y) < clearance for other in world.stations):
+            return False
+    obstacles = [*world.stations, dock_box(world)]
+    for i, start in enumerate(points):
+        for end in points[i + 1 :]:
+            if any(_segment_gap(start, end, other) < CORRIDOR for other in obstacles):
+                return False
+    return True
+
+
+def _bench_corners(station) -> list[tuple[float, float]]:  # noqa: ANN001 - a lab.world.Station
+    pose, (depth, width, _) = station.table_pose, station.table_size
+    c, s = math.cos(pose.yaw), math.sin(pose.yaw)
+    return [
+        (pose.x + c * dx - s * dy, pose.y + s * dx + c * dy)
+        for dx in (-depth / 2, depth / 2)
+        for dy in (-width / 2, width / 2)
+    ]
+
+
+def _segment_gap(start, end, station, step: float = 0.05) -> float:  # noqa: ANN001
+    """Least distance from the straight drive start -> end to the station's bench."""
+    length = math.hypot(end.x - start.x, end.y - start.y)
+    count = max(1, math.ceil(length / step))
+    return min(
+        bench_distance(
+            station, start.x + (end.x - start.x) * k / count, start.y + (end.y - start.y) * k / count
+        )
+        for k in range(count + 1)
+    )
+
+
+def _plates(rng: random.Random, stations: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The plate to move on any nest of the first station; others on other nests (the second station
+    keeps at least one free nest) and sometimes in hotel slot 2."""
+    types = list(LABWARE_TYPES)
+    source = stations[0]
+    plates = [
+        {
+            "id": "plate_001",
+            "type": rng.choice(types),
+            "station": source["name"],
+            "sub_position": rng.randint(1, source["nests"]["sub_positions"]),
+        }
+    ]
+    taken = {(plates[0]["station"], plates[0]["sub_position"])}
+    for index, station in enumerate(stations):
+        nests = list(range(1, station["nests"]["sub_positions"] + 1))
+        if index == 1:
+            nests.remove(rng.choice(nests))  # the destination stays free
+        for nest in nests:
+            holder = (station["name"], nest)
+            if holder in taken or rng.random() >= RANGES["occupied_nest_chance"]:
+                continue
+            taken.add(holder)
+            plates.append(
+                {
+                    "id": f"plate_{len(plates) + 1:03d}",
+                    "type": rng.choice(types),
+                    "station": holder[0],
+                    "sub_position": nest,
+                }
+            )
+    if rng.random() < RANGES["hotel_plate_chance"]:
+        plates.append({"id": f"plate_{len(plates) + 1:03d}", "type": rng.choice(types), "hotel_slot": 2})
+    return plates
