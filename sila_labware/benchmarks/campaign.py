@@ -38,9 +38,8 @@ from sila_labware.deployment.stack import Deployment, DeploymentOptions
 logger = logging.getLogger(__name__)
 
 CAUSES = ("positioning", "perception", "grasp", "navigation", "collision", "other")
-# Robot-side error codes (labware_interfaces/msg/ErrorCodes) -> failure cause of the success table.
-# COLLISION first: a goal stopped by an unintended contact is a collision whatever the step (the
-# robot side fails every motion running then; the plate may still have arrived).
+# Robot-side error codes (labware_interfaces/msg/ErrorCodes) -> failure cause of the success table;
+# COLLISION first: an unintended contact is a collision whatever the step (the plate may still arrive).
 CAUSE_BY_ERROR_CODE = {
     "COLLISION": "collision",
     "NAVIGATION_FAILED": "navigation",
