@@ -5,7 +5,8 @@ correction must belong to one instant of simulated time, and a run must be repro
 seed whatever the machine's load. Why only while the base moves (plus a few scans once it stops):
 a standing base's odometry does not change, so further scans could only average the range noise
 down, and the sim thread's CPU is what the real-time factor is made of. A scan at rest is still
-taken every ``REST_SCAN_PERIOD_S`` for /scan (a robot's laser does not go dark when it stops).
+taken every ``REST_SCAN_PERIOD_S`` while someone reads them (``scans_wanted``: /scan has
+subscribers).
 
 The correction goes to the base through ``DiffDriveBase.correct`` (applied at once at rest,
 rate-limited during a drive, held during a relative drive). Ground truth is never read here.
@@ -37,6 +38,14 @@ MAP_RESOLUTION = 0.01  # m: the localiser's own rasterisation of the world (surf
 MOVED_M, MOVED_RAD = 1e-4, 1e-4  # odometry change that counts as motion
 
 
+@dataclass(frozen=True)
+class Localised:
+    """One localisation update and the simulated time of its scan."""
+
+    sim_time: float
+    update: LocalisationUpdate
+
+
 @dataclass
 class LocalisationCost:
     """CPU seconds of the sim thread spent on laser ray casting and on matching, and their counts."""
@@ -57,8 +66,11 @@ class LocalisationLoop:
         self.localiser = Localiser(
             self.field, (dock.x, dock.y, dock.yaw), sim.odometry(), range_sigma_m=sim.laser.spec.range_noise_m
         )
-        self.latest: LocalisationUpdate | None = None
+        self.latest: Localised | None = None
         self.latest_scan: LaserReading | None = None
+        # Scans at rest for whoever reads them (/scan has subscribers, obstacle checks): set from
+        # outside; off, a standing base takes no scans beyond its last REST_UPDATES.
+        self.scans_wanted = False
         self.cost = LocalisationCost()
         self._odometry = sim.odometry()
         self._rest_updates = 0
@@ -76,7 +88,7 @@ class LocalisationLoop:
         if moved:
             self._rest_updates = 0
         matching = moved or self._rest_updates < REST_UPDATES
-        if not matching and sim.sim_time - self._last_scan_s < REST_SCAN_PERIOD_S:
+        if not matching and (not self.scans_wanted or sim.sim_time - self._last_scan_s < REST_SCAN_PERIOD_S):
             return
         started = time.thread_time()
         reading = sim.laser.read(sim.sim_time, odometry)
@@ -92,7 +104,7 @@ class LocalisationLoop:
         points = scan_points(reading.ranges, spec.angles(), mount, spec.range_min, spec.range_max)
         update = self.localiser.update(odometry, points)
         sim.base.correct(update.map_from_odom)
-        self.latest = update
+        self.latest = Localised(reading.sim_time, update)
         self.cost.matches += 1
         self.cost.match_cpu_s += time.thread_time() - scanned
         if self.cost.matches % 1000 == 0:

@@ -42,6 +42,7 @@ from tiago_sim.node_main import spin_node
 from tiago_sim.robot.motion_library import DEFAULT_MOTIONS_FILE, load_motions
 from tiago_sim.sim_node.action_servers import RobotActionServers
 from tiago_sim.sim_node.behaviours import RobotBehaviours
+from tiago_sim.sim_node.localisation import LocalisationLoop
 from tiago_sim.sim_node.marker_motion import MarkerMotionBehaviour
 from tiago_sim.sim_node.publishers import StatePublishers
 from tiago_sim.sim_node.sim_thread import SimThread
@@ -83,8 +84,14 @@ class SimNode:
             marker_motion=self.marker_motion,
             gripper=self.behaviours.gripper,
         )
+        # the robot's localisation: laser scans against the map of the world the robot believes
+        self.localisation = sim_thread.run(lambda sim: LocalisationLoop(world, sim))
         self.publishers = StatePublishers(
-            node, sim_thread, pois=self.current_pois, activity=self.actions.activity.snapshot
+            node,
+            sim_thread,
+            pois=self.current_pois,
+            activity=self.actions.activity.snapshot,
+            localisation=self.localisation,
         )
         node.create_service(DescribeWorkcell, "/describe_workcell", self._describe_workcell)
         node.create_service(CheckPlacement, "/check_placement", self._check_placement)
