@@ -2,7 +2,7 @@
 
 Why on the simulation clock (SimClock) and not a wall-clock timer: scan, odometry and the
 correction must belong to one instant of simulated time, and a run must be reproducible from its
-seed whatever the machine's load. Why only while the base moves (plus a few scans once it stops):
+seed whatever the machine's load. Why only after the base moved some centimetres (plus a few scans once it stops):
 a standing base's odometry does not change, so further scans could only average the range noise
 down, and the sim thread's CPU is what the real-time factor is made of. A scan at rest is still
 taken every ``REST_SCAN_PERIOD_S`` while someone reads them (``scans_wanted``: /scan has
@@ -31,11 +31,17 @@ from tiago_sim.physics.base_laser import LaserReading
 
 log = logging.getLogger(__name__)
 
-PERIOD_S = 0.2  # 5 Hz while the base moves: 20 cm apart at TIAGo's top speed
-REST_UPDATES = 3  # scans matched after the base stopped
+PERIOD_S = 0.2  # the loop looks at odometry 5 times a second (20 cm apart at TIAGo's top speed)
+# A scan is matched once the base has moved this far since the last match (nav2's AMCL waits for
+# 0.25 m or 0.2 rad by default): every second look at top speed, every look at the final
+# approach's 0.3 m/s. Odometry drifts well under a millimetre over that.
+MATCH_AFTER_M, MATCH_AFTER_RAD = 0.15, 0.15
+REST_UPDATES = 2  # scans matched once the base stands, to settle the pose where work happens
 REST_SCAN_PERIOD_S = 1.0  # scans for /scan only, while the base stands
 MAP_RESOLUTION = 0.01  # m: the localiser's own rasterisation of the world (surfaces within 5 mm)
-MOVED_M, MOVED_RAD = 1e-4, 1e-4  # odometry change that counts as motion
+# odometry change within one period that counts as driving (a base that creeps by less, as it does
+# under arm motions, stands)
+MOVING_M, MOVING_RAD = 1e-3, 1e-3
 
 
 @dataclass(frozen=True)
@@ -72,7 +78,7 @@ class LocalisationLoop:
         # outside; off, a standing base takes no scans beyond its last REST_UPDATES.
         self.scans_wanted = False
         self.cost = LocalisationCost()
-        self._odometry = sim.odometry()
+        self._odometry = self._matched_odometry = sim.odometry()
         self._rest_updates = 0
         self._last_scan_s = -math.inf
         sim.clock.every(period_s, self._tick, sim.sim_time)
@@ -80,14 +86,12 @@ class LocalisationLoop:
 
     def _tick(self, sim: Any) -> None:
         odometry = sim.odometry()
-        moved = (
-            math.hypot(odometry[0] - self._odometry[0], odometry[1] - self._odometry[1]) > MOVED_M
-            or abs(math.remainder(odometry[2] - self._odometry[2], math.tau)) > MOVED_RAD
-        )
+        driving = _moved(self._odometry, odometry, MOVING_M, MOVING_RAD)
         self._odometry = odometry
-        if moved:
+        if driving:
             self._rest_updates = 0
-        matching = moved or self._rest_updates < REST_UPDATES
+        moved = _moved(self._matched_odometry, odometry, MATCH_AFTER_M, MATCH_AFTER_RAD)
+        matching = moved or (not driving and self._rest_updates < REST_UPDATES)
         if not matching and (not self.scans_wanted or sim.sim_time - self._last_scan_s < REST_SCAN_PERIOD_S):
             return
         started = time.thread_time()
@@ -98,7 +102,8 @@ class LocalisationLoop:
         self.cost.scan_cpu_s += scanned - started
         if not matching:
             return
-        self._rest_updates += 0 if moved else 1
+        self._rest_updates += 0 if driving else 1
+        self._matched_odometry = odometry
         spec = reading.spec
         mount = (spec.mount_x, spec.mount_y, spec.mount_yaw)
         points = scan_points(reading.ranges, spec.angles(), mount, spec.range_min, spec.range_max)
@@ -117,3 +122,11 @@ class LocalisationLoop:
             cost.scans, 1e3 * cost.scan_cpu_s / max(cost.scans, 1), cost.matches,
             1e3 * cost.match_cpu_s / max(cost.matches, 1), self.localiser.rejected,
         )  # fmt: skip
+
+
+def _moved(
+    before: tuple[float, float, float], after: tuple[float, float, float], metres: float, radians: float
+) -> bool:
+    """Odometry moved at least ``metres`` or turned at least ``radians`` from ``before`` to ``after``."""
+    shift = math.hypot(after[0] - before[0], after[1] - before[1])
+    return shift >= metres or abs(math.remainder(after[2] - before[2], math.tau)) >= radians

@@ -285,12 +285,20 @@ def main(argv: list[str] | None = None) -> int:
         idle_realtime_factor=args.idle_realtime_factor,
     )
 
+    built: list[SimNode] = []
+
     def build(node: Node) -> SimNode:
         sim_thread.start()
         sim_node = SimNode(node, robot_world(world, args), sim_thread, args.motions)
+        built.append(sim_node)
         log.info("sim node ready: world %s, %d stations", world.source, len(world.stations))
         return sim_node
 
+    def shut_down() -> None:
+        sim_thread.stop()
+        for sim_node in built:  # what localisation cost the sim thread, beside its own figures
+            sim_node.localisation.log_cost()
+
     return spin_node(
-        "tiago_sim", lambda: MultiThreadedExecutor(num_threads=8), build, before_shutdown=sim_thread.stop
+        "tiago_sim", lambda: MultiThreadedExecutor(num_threads=8), build, before_shutdown=shut_down
     )
