@@ -2,10 +2,11 @@
 
 Why on the simulation clock (SimClock) and not a wall-clock timer: scan, odometry and the
 correction must belong to one instant of simulated time, and a run must be reproducible from its
-seed whatever the machine's load. Why only after the base moved some centimetres (plus a few scans once it stops):
-a standing base's odometry does not change, so further scans could only average the range noise
-down, and the sim thread's CPU is what the real-time factor is made of. A scan at rest is still
-taken every ``REST_SCAN_PERIOD_S`` while someone reads them (``scans_wanted``: /scan has
+seed whatever the machine's load. Why a match only after the base moved some centimetres (plus
+a few once it stops): odometry drifts by well under a millimetre in between, a standing base's
+odometry does not change, so further scans could only average the range noise down, and the sim
+thread's CPU is what the real-time factor is made of. A scan at rest is still taken every
+``REST_SCAN_PERIOD_S`` while someone reads them (``scans_wanted``: /scan has
 subscribers).
 
 The correction goes to the base through ``DiffDriveBase.correct`` (applied at once at rest,
