@@ -1,12 +1,13 @@
 """The base laser: a planar range finder at TIAGo's base laser mount, cast with rayTestBatch.
 
-Why these numbers: TIAGo++'s base (PAL PMB-2) carries a SICK TiM561 (Hokuyo URG-04LX on older
-units) looking out through a slot in the front of the base. The TiM561 datasheet: 0.05 to 10 m,
-270 deg aperture of which the base's slot leaves about 220 deg (PAL's description limits the beam
-to +-110 deg), 15 Hz, 0.33 deg angular resolution, statistical range error about 20 mm (1 sigma).
-The mount is ``base_laser_link`` 0.202 m ahead of base_link and 0.004 m below it: 0.0945 m above
-the floor, on the base's axis, level. Benches (solid to the floor), the dock and walls are what it
-sees; anything higher (bench tops' overhangs, marker stands on benches) it does not.
+Why these numbers: TIAGo++'s base (PAL PMB-2) carries a SICK TiM561 (a Hokuyo URG-04LX on older
+units) that looks out through a slot in the front of the base. The TiM561 datasheet: 0.05 to 10 m,
+270 deg aperture, 15 Hz, 0.33 deg angular resolution, statistical range error about 20 mm (1 sigma);
+the base's slot leaves about 220 deg of it (+-110 deg), the figure PAL's simulation uses. The mount,
+``base_laser_link``, is 0.202 m ahead of base_link and 0.004 m below it (PMB-2 description, as
+transcribed from memory, not checked against PAL's files here): 0.0945 m above the floor, on the
+base's axis, level. At that height it sees benches (solid to the floor), the dock, walls and
+obstacles standing on the floor; nothing mounted higher (marker stands on the benches).
 
 Idealisations (said in the README): the scan is taken at one instant (a real 15 Hz scan smears
 over 67 ms of motion); the range noise is Gaussian, independent per beam, without the datasheet's
