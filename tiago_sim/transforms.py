@@ -2,15 +2,19 @@
 
 Naming: ``T_a_b`` is the pose of frame ``b`` expressed in frame ``a`` (maps points from b to a),
 so ``T_a_c = T_a_b @ T_b_c``. Quaternions are (x, y, z, w), as PyBullet and ROS order them.
+Planar poses on the floor (x, y, yaw) have their own small helpers: the base and localisation
+compose them every step, where 4x4 matrices would cost more than the arithmetic.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
 
 Matrix4 = np.ndarray
+Planar = tuple[float, float, float]  # x, y (m), yaw (rad) on the floor
 
 
 def quat_to_matrix(quat_xyzw: Sequence[float]) -> np.ndarray:
@@ -125,3 +129,15 @@ def rotation_angle(rotation_a: np.ndarray, rotation_b: np.ndarray) -> float:
     relative = np.asarray(rotation_a).T @ np.asarray(rotation_b)
     cos_angle = np.clip((np.trace(relative) - 1.0) / 2.0, -1.0, 1.0)
     return float(np.arccos(cos_angle))
+
+
+def compose_planar(a: Planar, b: Planar) -> Planar:
+    """Planar pose ``b`` given in the frame of planar pose ``a``, expressed in ``a``'s parent frame."""
+    c, s = math.cos(a[2]), math.sin(a[2])
+    return (a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], math.remainder(a[2] + b[2], math.tau))
+
+
+def invert_planar(a: Planar) -> Planar:
+    """The planar transform that undoes ``a``: compose_planar(a, invert_planar(a)) is the identity."""
+    c, s = math.cos(a[2]), math.sin(a[2])
+    return (-c * a[0] - s * a[1], s * a[0] - c * a[1], math.remainder(-a[2], math.tau))

@@ -18,11 +18,18 @@ from tiago_sim.lab.world import Pose2D
 from tiago_sim.physics.motion import CANCELED, Motion, SequenceMotion
 from tiago_sim.physics.robot_body import RobotBody
 from tiago_sim.robot import robot_model as rm
+from tiago_sim.transforms import compose_planar as compose
+from tiago_sim.transforms import invert_planar as invert
 
 POSITION_TOLERANCE = 0.01  # m
 YAW_TOLERANCE = 0.01  # rad
 HEADING_GAIN = 2.5
 BLEND_ANGLE = 0.3  # rad: the drive starts once the heading is this close; the heading loop finishes the turn
+# How fast localisation's correction may move the believed pose while a drive runs: a typical
+# correction (under 1 cm, 0.3 deg) is in within 0.2 s; a large one is spread over seconds, which
+# the drive's heading loop (gain 2.5 /s) follows without a kink. At rest it applies at once.
+CORRECTION_SPEED = 0.05  # m/s
+CORRECTION_TURN_RATE = 0.03  # rad/s
 
 
 def wrap_angle(angle: float) -> float:
@@ -81,13 +88,42 @@ class DiffDriveBase:
         # localisation's correction (x, y, yaw of the odometry frame in the map); identity until a
         # localiser sets it. Drives close their loop on ``estimate()``, never on raw odometry.
         self.map_from_odom = (0.0, 0.0, 0.0)
+        self.map_from_odom_target: tuple[float, float, float] | None = None  # see correct()
+        self.driven = False  # a base motion runs (Simulation.step sets it every step)
+        self.hold_correction = False  # set every step by a drive whose goal is relative to its start
 
     def estimate(self) -> tuple[float, float, float]:
         """The base's pose in the map as the robot believes it: odometry with localisation's correction."""
         ox, oy, oyaw = self.odom
-        tx, ty, tyaw = self.map_from_odom
-        c, s = math.cos(tyaw), math.sin(tyaw)
-        return (tx + c * ox - s * oy, ty + s * ox + c * oy, wrap_angle(tyaw + oyaw))
+        return compose(self.map_from_odom, (ox, oy, oyaw))
+
+    def correct(self, map_from_odom: tuple[float, float, float]) -> None:
+        """Localisation's new correction. Applied by ``update``: at once while no drive runs,
+        rate-limited while one does, not at all during a relative drive (undock, the marker-guided
+        final approach: their goal was measured from where the base stood, and a shift of the
+        map frame under them would move the goal off what was measured)."""
+        self.map_from_odom_target = tuple(float(v) for v in map_from_odom)  # type: ignore[assignment]
+
+    def _apply_correction(self, dt: float) -> None:
+        target, hold = self.map_from_odom_target, self.hold_correction
+        self.hold_correction = False
+        if target is None or hold:
+            return
+        if not self.driven:
+            self.map_from_odom, self.map_from_odom_target = target, None
+            return
+        # limit how far the believed base pose moves this step, then re-derive the frame from it
+        ox, oy, oyaw = self.odom
+        x, y, yaw = compose(self.map_from_odom, (ox, oy, oyaw))
+        tx, ty, tyaw = compose(target, (ox, oy, oyaw))
+        shift = math.hypot(tx - x, ty - y)
+        scale = min(1.0, CORRECTION_SPEED * dt / shift) if shift > 0.0 else 1.0
+        turn = wrap_angle(tyaw - yaw)
+        turn = min(max(turn, -CORRECTION_TURN_RATE * dt), CORRECTION_TURN_RATE * dt)
+        believed = (x + scale * (tx - x), y + scale * (ty - y), yaw + turn)
+        self.map_from_odom = compose(believed, invert((ox, oy, oyaw)))
+        if scale >= 1.0 and abs(wrap_angle(tyaw - yaw)) <= CORRECTION_TURN_RATE * dt:
+            self.map_from_odom, self.map_from_odom_target = target, None
 
     def command(self, v: float, w: float) -> None:
         self.v_cmd = min(max(v, -rm.MAX_LINEAR_SPEED), rm.MAX_LINEAR_SPEED)
@@ -122,6 +158,7 @@ class DiffDriveBase:
         ]
         if self.v != 0.0 or self.w != 0.0:
             self.body.set_base_target(*self.target)
+        self._apply_correction(dt)
 
     def integrate_odometry(self, dt: float) -> None:
         """After the physics step: wheel encoders count the base's real displacement, with error."""
@@ -171,9 +208,11 @@ class DriveMotion(Motion):
         speed: float = rm.MAX_LINEAR_SPEED,
         stop_when=None,
         name: str = "drive",
+        relative: bool = False,
     ) -> None:
         super().__init__(name, frozenset({"base"}))
         self.base = base
+        self.relative = relative  # the goal was measured from where the base stood: hold the map frame
         self.goal = (x, y, yaw)
         self.reverse = reverse
         self.speed = speed
@@ -211,6 +250,7 @@ class DriveMotion(Motion):
 
     def tick(self, dt: float) -> None:
         base = self.base
+        base.hold_correction = base.hold_correction or self.relative
         if self.cancel_requested:
             base.command(0.0, 0.0)
             self.phase = "stopping"

@@ -23,6 +23,7 @@ from tiago_sim.navigation.planner import Plan
 from tiago_sim.perception.camera import CameraIntrinsics, render_rgbd
 from tiago_sim.physics.arm_controller import JointTrajectoryMotion
 from tiago_sim.physics.base_controller import DiffDriveBase, DriveMotion, docking_motion
+from tiago_sim.physics.base_laser import BaseLaser, LaserSpec, laser_rng
 from tiago_sim.physics.collision_watch import COLLISION, CollisionWatch
 from tiago_sim.physics.gripper_controller import HOLDER_FRICTION, Gripper, GripperMotion
 from tiago_sim.physics.hotel_clamp import HotelClamp
@@ -32,6 +33,7 @@ from tiago_sim.physics.plate_proximity import STEP_REVIEW_PERIOD, PlateProximity
 from tiago_sim.physics.plate_sensing import PlateSensing
 from tiago_sim.physics.robot_body import RobotBody
 from tiago_sim.physics.scene import build_scene
+from tiago_sim.physics.sim_clock import SimClock
 from tiago_sim.physics.step_ledger import StepLedger
 from tiago_sim.physics.tool_path import STRAIGHT_STEP, plan_tool_path
 from tiago_sim.robot import robot_model as rm
@@ -103,6 +105,8 @@ class Simulation:
         self.scene = build_scene(c, world, self.T_world_slot_at_start)
         dock = world.dock_pose
         self.base = DiffDriveBase(self.robot, dock.x, dock.y, dock.yaw, odometry_noise, self.rng)
+        self.laser = BaseLaser(c, self.robot, LaserSpec(), laser_rng(seed))
+        self.clock = SimClock()  # sensors and robot software at fixed simulated rates
         self.grippers = {side: Gripper(self.robot, side, self.scene.plates) for side in rm.ARM_SIDES}
         self.hotel_clamp = HotelClamp(self.robot, self.scene.plates)
         self._clamped_for_drive = False
@@ -139,6 +143,7 @@ class Simulation:
             base_driven = base_driven or ("base" in motion.resources and not motion.done)
         if not base_driven:
             self.base.command(0.0, 0.0)  # no drive running: the base brakes and stands
+        self.base.driven = base_driven
         self._clamp_while_driving(base_driven)
         self.base.update(dt)
         started = time.thread_time()
@@ -149,6 +154,7 @@ class Simulation:
         self.base.integrate_odometry(dt)
         self.sim_time += dt
         self.last_step_s = dt
+        self.clock.tick(self)
         if any(m.done for m in motions):
             self.motions = [m for m in motions if not m.done]
 
@@ -277,10 +283,13 @@ class Simulation:
         return self.plate_sensing.held_reading(arm, gripper.touching() or gripper.attached_id)
 
     # ----------------------------------------------------------------- motions
-    def drive_to(self, x: float, y: float, yaw: float, speed: float = rm.MAX_LINEAR_SPEED) -> Motion:
+    def drive_to(
+        self, x: float, y: float, yaw: float, speed: float = rm.MAX_LINEAR_SPEED, relative: bool = False
+    ) -> Motion:
+        """To a map pose; ``relative``: measured from where the base stands (DriveMotion)."""
         if self.is_docked():
             return FailedMotion("drive", "DOCKED", "undock first")
-        return self._start(DriveMotion(self.base, x, y, yaw, speed=speed))
+        return self._start(DriveMotion(self.base, x, y, yaw, speed=speed, relative=relative))
 
     def follow_path(self, plan: Plan, yaw: float, speed: float = rm.MAX_LINEAR_SPEED) -> Motion:
         """Drive a planned path (navigation.planner) segment by segment, ending facing ``yaw``."""
@@ -298,13 +307,11 @@ class Simulation:
         """Drive straight ahead off the dock, as far as the dock POI lies in front of the dock."""
         if not self.is_docked():
             return CompletedMotion("undock", "not docked")
-        x, y, yaw = self.odometry()
-        distance = math.dist(
-            (self.world.dock_pose.x, self.world.dock_pose.y),
-            (self.world.pois[self.world.dock_poi].x, self.world.pois[self.world.dock_poi].y),
-        )
+        x, y, yaw = self.pose_estimate()  # the frame the drive closes its loop in
+        poi, dock = self.world.pois[self.world.dock_poi], self.world.dock_pose
+        distance = math.dist((dock.x, dock.y), (poi.x, poi.y))
         goal = (x + distance * math.cos(yaw), y + distance * math.sin(yaw), yaw)
-        motion = DriveMotion(self.base, *goal, speed=0.3, name="undock")  # contacts open at once: no creep
+        motion = DriveMotion(self.base, *goal, speed=0.3, name="undock", relative=True)  # no creep
         motion.phase = "driving"
         return self._start(motion)
 

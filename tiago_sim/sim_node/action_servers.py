@@ -34,6 +34,7 @@ FAULT_CODES = frozenset(
         ErrorCodes.GRASP_FAILED,
         ErrorCodes.PLATE_SLIPPED,
         ErrorCodes.PLACE_FAILED,
+        ErrorCodes.COLLISION,
         ErrorCodes.INTERNAL,
     }
 )

@@ -10,8 +10,8 @@ seed 2041); then the robot looks at the station's marker, works out where the wo
 (``work_standoff``) really is, and drives the last ~22 cm there. The torso rises to the bench
 working height and the head turns to the bench during that drive (independent joints overlap).
 
-Only robot knowledge is used: the head camera image and depth, joint readings, odometry and the
-kinematic model; the station's geometry comes from the believed (nominal) world file.
+Only robot knowledge is used: the head camera image and depth, joint readings, odometry, the
+localised pose and the kinematic model; the station's geometry comes from the believed (nominal) world file.
 Lives on: an rclpy executor thread (inside a /marker_motion goal).
 """
 
@@ -40,14 +40,6 @@ ALIGN_SPEED = 0.3  # m/s cap for the short final drive (the acceleration limit k
 def planar(transform: np.ndarray) -> tuple[float, float, float]:
     """x, y and heading of a frame's x axis projected on the floor plane."""
     return float(transform[0, 3]), float(transform[1, 3]), math.atan2(transform[1, 0], transform[0, 0])
-
-
-def compose_planar(
-    a: tuple[float, float, float], b: tuple[float, float, float]
-) -> tuple[float, float, float]:
-    """Planar pose b, given in the frame of planar pose a, expressed in a's parent frame."""
-    c, s = math.cos(a[2]), math.sin(a[2])
-    return a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], tf.wrap_angle(a[2] + b[2])
 
 
 def _search(run: ActionRun, kinematics: RobotKinematics, target: np.ndarray, look: Any, lifting: Any) -> Any:
@@ -92,9 +84,9 @@ def align_base(
     `look(run)` takes an image and returns the marker sighting (T_base_marker); `working_joints`
     are torso/head targets that move while the base drives (e.g. the bench working posture).
     """
-    # Where odometry says the base stands, not the POI: a task may start where the last one
-    # ended, at the working pose 0.22 m nearer.
-    believed = run.sim(lambda sim: tuple(sim.odometry()))
+    # Where the base believes it stands (localisation), not the POI: a task may start where the
+    # last one ended, at the working pose 0.22 m nearer.
+    believed = run.sim(lambda sim: tuple(sim.pose_estimate()))
     T_base_marker_expected = tf.invert(tf.from_planar(*believed)) @ station.T_world_marker()
     # The torso starts rising at once (it is the slowest joint); the image is taken with the joint
     # readings of the same instant, so the camera pose stays exact while it moves.
@@ -105,8 +97,16 @@ def align_base(
         sighting = _search(run, kinematics, T_base_marker_expected[:3, 3], look, lifting)
         T_marker_work = tf.invert(station.T_world_marker()) @ station.aligned_pose().matrix()
         correction = planar(sighting.T_base_marker @ T_marker_work)  # working pose in base_footprint
-        odometry = run.sim(lambda sim: tuple(sim.odometry()))
-        goal = compose_planar(odometry, correction)
+        # The goal is fixed in the odometry frame (where the base stood at the sighting) and put
+        # into the map frame the drive closes its loop in at the instant the drive starts; the
+        # drive is relative, so localisation holds the map frame still under it.
+        goal_in_odom = tf.compose_planar(sighting.odometry, correction)
+
+        def drive(sim: Any) -> Any:
+            odom_to_map = tf.compose_planar(sim.pose_estimate(), tf.invert_planar(sim.odometry()))
+            goal = tf.compose_planar(odom_to_map, goal_in_odom)
+            return sim.drive_to(*goal, speed=ALIGN_SPEED, relative=True)
+
         log.info(
             "aligning at %s: working pose at x %.3f y %.3f m, yaw %.1f deg from here",
             station.name, correction[0], correction[1], math.degrees(correction[2]),
@@ -114,7 +114,7 @@ def align_base(
         head_at_work = {name: value for name, value in working_joints.items() if name in HEAD_JOINTS}
         turning = run.sim(lambda sim: sim.move_joints(head_at_work)) if head_at_work else None
         background.append(turning)
-        run.run_motion(lambda sim: sim.drive_to(*goal, speed=ALIGN_SPEED), span=(0.2, 0.9))
+        run.run_motion(drive, span=(0.2, 0.9))
         for motion, span in ((lifting, (0.9, 0.95)), (turning, (0.95, 1.0))):
             if motion is not None:
                 run.run_motion(lambda _sim, motion=motion: motion, span=span)

@@ -44,6 +44,7 @@ from tiago_sim.robot.motion_library import DEFAULT_MOTIONS_FILE, load_motions
 from tiago_sim.sim_node.action_servers import RobotActionServers
 from tiago_sim.sim_node.behaviours import RobotBehaviours
 from tiago_sim.sim_node.lab_reset import LabReset
+from tiago_sim.sim_node.localisation import LocalisationLoop
 from tiago_sim.sim_node.marker_motion import MarkerMotionBehaviour
 from tiago_sim.sim_node.navigation import Navigation
 from tiago_sim.sim_node.publishers import StatePublishers
@@ -87,8 +88,14 @@ class SimNode:
             marker_motion=self.marker_motion,
             gripper=self.behaviours.gripper,
         )
+        # the robot's localisation: laser scans against the map of the world the robot believes
+        self.localisation = sim_thread.run(lambda sim: LocalisationLoop(world, sim))
         self.publishers = StatePublishers(
-            node, sim_thread, pois=self.current_pois, activity=self.actions.activity.snapshot
+            node,
+            sim_thread,
+            pois=self.current_pois,
+            activity=self.actions.activity.snapshot,
+            localisation=self.localisation,
         )
         self.lab_reset = LabReset(node, sim_thread, self.actions.slot)
         self.lab_reset.hooks.append(self._forget_the_old_lab)
@@ -165,7 +172,10 @@ class SimNode:
             self.sim_thread.watch(self.plate_faults.drop_if_driving)
 
     def _forget_the_old_lab(self) -> None:
-        """After a reset: no fault stands, no grasp is remembered, no error shows."""
+        """After a reset: localisation starts again at the dock on the new Simulation; no fault
+        stands, no grasp is remembered, no error shows."""
+        self.localisation = self.sim_thread.run(lambda sim: LocalisationLoop(self.world, sim))
+        self.publishers.localisation = self.localisation
         self.occluders = Occluders(self.world)
         self.plate_faults = PlateFaults()
         self.node.set_parameters(
@@ -309,12 +319,20 @@ def main(argv: list[str] | None = None) -> int:
         idle_realtime_factor=args.idle_realtime_factor,
     )
 
+    built: list[SimNode] = []
+
     def build(node: Node) -> SimNode:
         sim_thread.start()
         sim_node = SimNode(node, robot_world(world, args), sim_thread, args.motions)
+        built.append(sim_node)
         log.info("sim node ready: world %s, %d stations", world.source, len(world.stations))
         return sim_node
 
+    def shut_down() -> None:
+        sim_thread.stop()
+        for sim_node in built:  # what localisation cost the sim thread, beside its own figures
+            sim_node.localisation.log_cost()
+
     return spin_node(
-        "tiago_sim", lambda: MultiThreadedExecutor(num_threads=8), build, before_shutdown=sim_thread.stop
+        "tiago_sim", lambda: MultiThreadedExecutor(num_threads=8), build, before_shutdown=shut_down
     )

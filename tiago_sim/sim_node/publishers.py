@@ -1,4 +1,5 @@
-"""Topics of the sim node: /clock, /odom, /joint_states, /robot_state, /station_states, camera.
+"""Topics of the sim node: /clock, /odom, /joint_states, /robot_state, /station_states, camera,
+and localisation's (/scan, /amcl_pose, /map_to_odom: localisation_topics).
 
 A wall-clock timer (executor thread) takes one snapshot of the robot's own sensors from the sim
 thread and publishes it; nothing here touches PyBullet directly. /robot_state goes out when it
@@ -27,6 +28,8 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import CameraInfo, Image, JointState
 
 from labware_model.readings import HotelSlotReading, NestReading
+from tiago_sim.sim_node.localisation import LocalisationLoop
+from tiago_sim.sim_node.localisation_topics import LocalisationTopics, LocalisationView, stamp_of
 from tiago_sim.sim_node.sim_thread import SimThread
 from tiago_sim.transforms import wrap_angle
 
@@ -50,6 +53,8 @@ class RobotSnapshot:
     held_labware_id: str
     nests: list[NestReading] = field(default_factory=list)
     true_base_pose: tuple[float, float, float] | None = None  # simulator truth, for measurement only
+    pose_estimate: tuple[float, float, float] | None = None  # localised; None: odometry stands for it
+    localisation: LocalisationView = LocalisationView(None, None)
     activity: tuple[str, str] = ("", "")  # (state or "", detail) of the action servers at that instant
     passed_activities: tuple[tuple[str, str], ...] = ()  # goals begun and ended since the last snapshot
 
@@ -68,6 +73,7 @@ def take_snapshot(sim: Any) -> RobotSnapshot:
         held_labware_id=held,
         nests=list(sim.nest_readings()),
         true_base_pose=_true_base_pose(sim),
+        pose_estimate=tuple(float(v) for v in sim.pose_estimate()),
     )
 
 
@@ -91,11 +97,6 @@ def _occupied_nests(nests: tuple[NestReading, ...]) -> str:
         for reading in nests
         if reading.occupied
     )
-
-
-def stamp_of(sim_time: float) -> Time:
-    seconds = math.floor(sim_time)
-    return Time(sec=int(seconds), nanosec=int((sim_time - seconds) * 1e9))
 
 
 def poi_at(
@@ -124,6 +125,7 @@ class StatePublishers:
         *,
         pois: Callable[[], dict[str, tuple[float, float, float]]],
         activity: Callable[[], Any],
+        localisation: LocalisationLoop | None = None,
         rate_hz: float = 20.0,
         camera_rate_hz: float = 2.0,
     ) -> None:
@@ -131,6 +133,8 @@ class StatePublishers:
         self.sim_thread = sim_thread
         self.pois = pois
         self.activity = activity  # -> action_servers.ActivityReport
+        self.localisation = localisation
+        self.localisation_topics = LocalisationTopics(node)
         self.latest: RobotSnapshot | None = None
         # Wide enough to cover the marker-guided final approach (the base works ~12 cm closer to
         # the table than the station's POI) plus navigation error; POIs lie metres apart.
@@ -162,6 +166,8 @@ class StatePublishers:
         Why not publish it one tick later: the sequencer checks each step's effect on a report read
         after the step, and that wait was one tick (50 ms) longer, nine times a transfer."""
         if self._pending is None:
+            if self.localisation is not None:  # a plain flag the sim thread reads
+                self.localisation.scans_wanted = self.localisation_topics.scans_wanted()
             self._pending = self.sim_thread.call(self._snapshot_with_activity)
         try:
             snapshot = self._pending.result(timeout=SNAPSHOT_WAIT_S)
@@ -177,8 +183,15 @@ class StatePublishers:
         """Sensors and activity read at the same instant (on the sim thread): a state read later
         than the pose said "idle" beside the pose of a base still braking (10 cm off, under load)."""
         report = self.activity()
+        loop = self.localisation
+        view = LocalisationView(None, None)
+        if loop is not None:
+            view = LocalisationView(loop.latest_scan, loop.latest)
         return replace(
-            take_snapshot(sim), activity=(report.state, report.detail), passed_activities=report.passed
+            take_snapshot(sim),
+            activity=(report.state, report.detail),
+            passed_activities=report.passed,
+            localisation=view,
         )
 
     def _publish(self, snapshot: RobotSnapshot) -> None:
@@ -186,6 +199,7 @@ class StatePublishers:
         stamp = stamp_of(snapshot.sim_time)
         self.clock_pub.publish(Clock(clock=stamp))
         self._publish_odometry(snapshot, stamp)
+        self.localisation_topics.publish(snapshot.localisation)
         joints = JointState()
         joints.header.stamp = stamp
         joints.name = list(snapshot.joint_positions)
@@ -254,10 +268,10 @@ class StatePublishers:
         else:
             message.state = RobotState.STATE_IDLE
         message.detail = detail
-        message.current_poi = poi_at(
-            snapshot.odometry, self.pois(), self.poi_tolerance_m, self.poi_yaw_tolerance_rad
-        )
-        x, y, yaw = snapshot.odometry
+        # where the robot believes it stands: the localised pose (odometry only if there is none)
+        believed = snapshot.pose_estimate or snapshot.odometry
+        message.current_poi = poi_at(believed, self.pois(), self.poi_tolerance_m, self.poi_yaw_tolerance_rad)
+        x, y, yaw = believed
         message.base_pose = Pose2D(x=x, y=y, theta=yaw)
         message.hotel = [
             HotelSlot(

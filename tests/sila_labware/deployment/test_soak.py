@@ -6,7 +6,9 @@ outside (/proc) and talks to it only as a scheduler would (SiLA over gRPC).
 
 Run apart from the quick suite: `pytest -m soak tests/sila_labware/deployment/test_soak.py -s`
 (the figures are printed and, with SOAK_REPORT=path, written as JSON). SOAK_TRANSFERS changes the
-count (default 50).
+count (default 50); SOAK_PORT_BASE fixes the servers' first port (default: a free block). After
+every transfer the localised pose and raw odometry are compared with the simulator's truth
+(tests/helpers/pose_errors); the report gives their median, maximum and last values.
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sila2.client import SilaClient
 
 from ros_bridge.runtime import RosRuntime
+from tests.helpers.pose_errors import PoseErrorProbe
 from tests.helpers.sila_stack import free_port_base
 from tests.helpers.transfer_steps import Cell
 
@@ -137,10 +140,22 @@ def unfinished_goals(runtime: RosRuntime, timeout_s: float = 5.0) -> dict[str, i
     }
 
 
+def summarise_pose_errors(samples: list[dict[str, float]]) -> dict[str, object]:
+    """Median, maximum and last value of each error over the transfers, and every sample."""
+    summary: dict[str, object] = {"samples": samples}
+    for key in ("localised_cm", "localised_deg", "odometry_cm", "odometry_deg"):
+        values = sorted(sample[key] for sample in samples if key in sample)
+        if values:
+            last = next(sample[key] for sample in reversed(samples) if key in sample)
+            summary[key] = {"median": values[len(values) // 2], "max": values[-1], "last": last}
+    return summary
+
+
 @pytest.mark.soak
 @pytest.mark.timeout(7200)
 def test_many_transfers_in_one_serve_process_leak_nothing(tmp_path: Path) -> None:
-    port_base = free_port_base(4, PORT_BASES)
+    fixed_port = os.environ.get("SOAK_PORT_BASE")
+    port_base = int(fixed_port) if fixed_port else free_port_base(4, PORT_BASES)
     stdout_path, stderr_path = tmp_path / "serve.out", tmp_path / "serve.err"
     with stdout_path.open("w") as stdout, stderr_path.open("w") as stderr:
         serve = subprocess.Popen(
@@ -164,6 +179,8 @@ def test_many_transfers_in_one_serve_process_leak_nothing(tmp_path: Path) -> Non
         }
         cell = ServedCell(robot, stations)
         runtime = RosRuntime("soak_observer").start()
+        pose_probe = PoseErrorProbe(runtime)
+        pose_errors: list[dict[str, float]] = []
 
         started = time.monotonic()
         durations: list[float] = []
@@ -182,10 +199,15 @@ def test_many_transfers_in_one_serve_process_leak_nothing(tmp_path: Path) -> Non
                 break
             durations.append(time.monotonic() - began)
             assert cell.location(PLATE) == (False, destination[0], destination[1])
+            pose_errors.append({"transfer": number, **pose_probe.sample()})
             if number <= 2 or number % 5 == 0 or number == TRANSFERS:
                 samples[number] = {name: sample(pid) for name, pid in watched.items()}
                 graph[number] = ros_graph_of_bridge(runtime)
-            print(f"transfer {number}: {source[0]} -> {destination[0]} in {durations[-1]:.1f} s", flush=True)
+            print(
+                f"transfer {number}: {source[0]} -> {destination[0]} in {durations[-1]:.1f} s; "
+                f"pose errors {pose_errors[-1]}",
+                flush=True,
+            )
         wall_s = time.monotonic() - started
 
         goals_left = unfinished_goals(runtime)
@@ -203,6 +225,7 @@ def test_many_transfers_in_one_serve_process_leak_nothing(tmp_path: Path) -> Non
             "bridge_graph": graph,
             "unfinished_goals": goals_left,
             "robot_state": cell.robot_state(),
+            "pose_errors": summarise_pose_errors(pose_errors),
         }
         print(json.dumps(report, indent=1), flush=True)
         if os.environ.get("SOAK_REPORT"):

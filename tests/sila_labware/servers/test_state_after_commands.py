@@ -35,12 +35,16 @@ def pose(cell: Cell) -> tuple[float, float, float]:
 
 
 def assert_stands_still(cell: Cell, wall_s: float = 1.0) -> None:
-    """The pose read now is the pose a moment later (1 s of wall time is seconds of robot time)."""
+    """The pose read now is the pose a moment later (1 s of wall time is seconds of robot time).
+
+    The pose is the localised one: the scans matched once the base stands (and the rest of a
+    correction a drive was applying gently) may still move it by millimetres; a base still
+    rolling or braking moves it by centimetres to decimetres."""
     before = pose(cell)
     time.sleep(wall_s)
     after = pose(cell)
-    assert math.dist(before[:2], after[:2]) < 0.002, (before, after)
-    assert abs(math.remainder(after[2] - before[2], math.tau)) < 0.005, (before, after)
+    assert math.dist(before[:2], after[:2]) < 0.01, (before, after)
+    assert abs(math.remainder(after[2] - before[2], math.tau)) < 0.01, (before, after)
 
 
 def stop_mid_drive(cell: Cell, stop: Callable[[Any], None]) -> None:

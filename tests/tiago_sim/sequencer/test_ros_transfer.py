@@ -9,16 +9,19 @@ plate put back in station_a:1, where the next test expects it.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator
 
 import pytest
 from action_msgs.msg import GoalStatus
+from geometry_msgs.msg import Pose2D, PoseWithCovarianceStamped, TransformStamped
 from labware_interfaces.action import GetLabware, NavigateToPoi, PlayMotion, PutLabware
 from labware_interfaces.msg import ErrorCodes, RobotState, StationStates
 from labware_interfaces.srv import CheckPlacement, DescribeWorkcell
 from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
 from rcl_interfaces.srv import SetParameters
-from sensor_msgs.msg import CameraInfo, Image, JointState
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from sensor_msgs.msg import CameraInfo, Image, JointState, LaserScan
 
 from tests.helpers.ros_processes import RosCaller, running
 from tests.helpers.sim_parameters import parameter_request
@@ -190,6 +193,36 @@ def test_occluded_marker_aborts_without_touching_the_plate(robot: RosCaller) -> 
     assert check.in_nest, f"plate disturbed: {check}"
 
 
+def subscribe_latched(robot: RosCaller, message_type: type, topic: str) -> None:
+    """As RViz subscribes to AMCL's pose: durable, so the last one published arrives."""
+    qos = QoSProfile(
+        depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
+    )
+    robot.node.create_subscription(message_type, topic, lambda msg: robot.latest.__setitem__(topic, msg), qos)
+
+
+def test_laser_scan_and_localised_pose_are_published_with_their_frames(robot: RosCaller) -> None:
+    robot.subscribe(LaserScan, "/scan")
+    subscribe_latched(robot, PoseWithCovarianceStamped, "/amcl_pose")
+    subscribe_latched(robot, TransformStamped, "/map_to_odom")
+    topics = ("/scan", "/amcl_pose", "/map_to_odom")
+    robot.wait_for(lambda: all(t in robot.latest for t in topics), 20.0, "laser and localisation topics")
+    scan = robot.latest["/scan"]
+    assert scan.header.frame_id == "base_laser_link" and len(scan.ranges) == 661
+    assert scan.angle_min == pytest.approx(math.radians(-110), abs=1e-6) and scan.range_max == 10.0
+    seen = [r for r in scan.ranges if math.isfinite(r)]
+    assert len(seen) > 50 and min(seen) >= scan.range_min  # the benches, never the robot itself
+    pose = robot.latest["/amcl_pose"]
+    assert pose.header.frame_id == "map"
+    believed = robot.latest["/robot_state"].base_pose  # the base stands: the same pose, both ways
+    assert (pose.pose.pose.position.x, pose.pose.pose.position.y) == pytest.approx(
+        (believed.x, believed.y), abs=0.01
+    )
+    assert 0 < pose.pose.covariance[0] < 0.02**2 and 0 < pose.pose.covariance[35] < math.radians(2) ** 2
+    correction = robot.latest["/map_to_odom"]
+    assert (correction.header.frame_id, correction.child_frame_id) == ("map", "odom")
+
+
 def test_plate_goes_a_to_hotel_to_b_and_back(robot: RosCaller) -> None:
     route = [
         (GetLabware, "/get_labware", "station_a", "hotel:1"),
@@ -208,6 +241,19 @@ def test_plate_goes_a_to_hotel_to_b_and_back(robot: RosCaller) -> None:
         assert check.location == expected_location, check
         if kind is PutLabware:
             assert check.in_nest, f"not within clearance: {check.position_error_m * 1000:.1f} mm"
+
+
+def test_after_the_transfers_the_believed_pose_is_the_localised_one_within_2_cm_of_the_truth(
+    robot: RosCaller,
+) -> None:
+    robot.subscribe(Pose2D, "/ground_truth/base_pose")  # the simulator's truth: only to measure here
+    robot.spin_for(1.5)
+    robot.wait_for(lambda: "/ground_truth/base_pose" in robot.latest, 10.0, "ground truth")
+    believed, truth = robot.latest["/robot_state"].base_pose, robot.latest["/ground_truth/base_pose"]
+    localised = robot.latest["/amcl_pose"].pose.pose
+    assert (believed.x, believed.y) == pytest.approx((localised.position.x, localised.position.y), abs=0.005)
+    assert math.hypot(believed.x - truth.x, believed.y - truth.y) < 0.02
+    assert abs(math.remainder(believed.theta - truth.theta, math.tau)) < math.radians(1.0)
 
 
 def set_sequencer_parameter(robot: RosCaller, name: str, value: float) -> None:

@@ -23,7 +23,8 @@ from tiago_sim import transforms as tf
 from tiago_sim.lab.world import load_world
 from tiago_sim.physics.simulation import Simulation
 from tiago_sim.robot.kinematics import RobotKinematics
-from tiago_sim.sim_node.base_alignment import compose_planar, head_angles_towards, planar
+from tiago_sim.sim_node.base_alignment import head_angles_towards, planar
+from tiago_sim.transforms import compose_planar
 
 PLATE = "plate_001"
 
