@@ -18,6 +18,7 @@ EXAMPLES = sorted(path for path in DEFAULT_WORLD.parent.glob("*.yaml") if path !
 # what the demo moves in each: the plate, from, to
 EXPECTED = {
     "bench_in_the_way": ("plate_001", "station_a/1", "station_b/1"),  # around bench_c, untouched
+    "furnished_lab": ("plate_001", "station_a/1", "station_b/1"),  # around a pillar and a cart
     "two_benches": ("plate_b", "bench_a/2", "bench_b/1"),
     "three_stations": ("mp_001", "reader/1", "incubator/1"),
 }
