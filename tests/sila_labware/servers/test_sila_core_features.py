@@ -101,10 +101,13 @@ def base_pose(cell: Cell) -> tuple[float, float, float]:
 
 
 def assert_base_at_rest(cell: Cell) -> None:
+    """The reported pose holds still: within 1 cm and 0.01 rad over a second (many seconds simulated).
+    A base still rolling moves by centimetres; a standing one's localised pose may settle by a few
+    millimetres with the scans matched just after it stopped (README, "Base laser and localisation")."""
     before = base_pose(cell)
     time.sleep(1.0)  # unpaced again: a second of wall time is many seconds of simulated time
     after = base_pose(cell)
-    assert max(abs(a - b) for a, b in zip(before, after, strict=True)) < 1e-3, (before, after)
+    assert max(abs(a - b) for a, b in zip(before, after, strict=True)) < 0.01, (before, after)
 
 
 def assert_joints_at_rest(cell: Cell) -> None:
