@@ -4,7 +4,11 @@ Why here and not on the sim thread: planning is pure (navigation.planner) and ta
 to tens of them; run on the goal's executor thread it never stalls physics. The map is the one the
 robot believes (the world file as the robot knows it, not the disturbed truth), published once and
 latched (transient local), as map_server does; the planning map, inflated by the robot's turning
-circle, goes out the same way on /global_costmap/costmap. Frames: ``map`` (the world frame; the
+circle, goes out the same way on /global_costmap/costmap. Things not on the map: the drive is
+watched by the base laser (physics.guarded_path); stopped short of an obstacle, the robot marks
+what it saw on a local copy of the map (this goal only; /map stays the static map) and plans again
+from its pose estimate; with no way round it waits and re-tries (a fresh scan forgets marks it
+now sees through) for BLOCKED_TIMEOUT_S of simulated time. Frames: ``map`` (the world frame; the
 base pose estimate is in it). Lives on: rclpy executor threads (goals, one at a time).
 """
 
