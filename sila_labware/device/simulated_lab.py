@@ -30,8 +30,11 @@ FAULT_PARAMETERS = {
     "DropPlate": "fault.drop_plate",
     "KnockPlate": "fault.knock_plate",
     "OccludeMarker": "fault.occlude_marker",
+    "BlockPath": "fault.block_path",
 }
-FAULTS_DURING_A_COMMAND = frozenset({"DropPlate", "KnockPlate", "OccludeMarker"})
+FAULTS_DURING_A_COMMAND = frozenset({"DropPlate", "KnockPlate", "OccludeMarker", "BlockPath"})
+TARGET_REFUSALS = ("unknown plate", "unknown station", "fault.block_path")
+"""How the sim node's refusal of a fault's target begins (tiago_sim.sim_node.node)."""
 REPORT_AFTER_RESET_S = 10.0  # the robot side reports its state at 20 Hz; generous under load
 
 
@@ -54,7 +57,7 @@ class SimulationRequestFailed(Exception):
 
 
 class UnknownFaultTarget(ParameterError):
-    """The fault's target names no plate or station of the lab."""
+    """The fault's target names no plate or station of the lab, or is no distance BlockPath takes."""
 
     def __init__(self, message: str) -> None:
         super().__init__("Target", message)
@@ -139,7 +142,7 @@ class SimulatedLab:
         try:
             self.simulation.set_parameters({FAULT_PARAMETERS[fault]: target})
         except BridgeError as error:
-            if "unknown plate" in str(error) or "unknown station" in str(error):
+            if any(refusal in str(error) for refusal in TARGET_REFUSALS):
                 raise UnknownFaultTarget(str(error).split(": ", 1)[-1]) from error
             raise SimulationRequestFailed(str(error)) from error
         with self._lock:

@@ -19,6 +19,7 @@ import pybullet as p
 from labware_model.holders import Nest
 from labware_model.readings import HotelSlotReading, NestReading, PlacementCheck
 from tiago_sim.lab.world import World
+from tiago_sim.navigation.blockage import UnmappedObstacles
 from tiago_sim.navigation.planner import Plan
 from tiago_sim.perception.camera import CameraIntrinsics, render_rgbd
 from tiago_sim.physics.arm_controller import JointTrajectoryMotion
@@ -26,6 +27,7 @@ from tiago_sim.physics.base_controller import DiffDriveBase, DriveMotion, dockin
 from tiago_sim.physics.base_laser import BaseLaser, LaserSpec, laser_rng
 from tiago_sim.physics.collision_watch import COLLISION, CollisionWatch
 from tiago_sim.physics.gripper_controller import HOLDER_FRICTION, Gripper, GripperMotion
+from tiago_sim.physics.guarded_path import GuardedPathMotion
 from tiago_sim.physics.hotel_clamp import HotelClamp
 from tiago_sim.physics.motion import BUSY, CompletedMotion, FailedMotion, Motion
 from tiago_sim.physics.path_following import path_motion
@@ -291,11 +293,19 @@ class Simulation:
             return FailedMotion("drive", "DOCKED", "undock first")
         return self._start(DriveMotion(self.base, x, y, yaw, speed=speed, relative=relative))
 
-    def follow_path(self, plan: Plan, yaw: float, speed: float = rm.MAX_LINEAR_SPEED) -> Motion:
-        """Drive a planned path (navigation.planner) segment by segment, ending facing ``yaw``."""
+    def follow_path(
+        self,
+        plan: Plan,
+        yaw: float,
+        speed: float = rm.MAX_LINEAR_SPEED,
+        watch: UnmappedObstacles | None = None,
+    ) -> Motion:
+        """Drive a planned path (navigation.planner) segment by segment, ending facing ``yaw``;
+        with ``watch``, stop short of obstacles the laser sees and the map lacks (guarded_path)."""
         if self.is_docked():
             return FailedMotion("drive", "DOCKED", "undock first")
-        return self._start(path_motion(self.base, plan, yaw, speed=speed))
+        motion = path_motion(self.base, plan, yaw, speed=speed)
+        return self._start(motion if watch is None else GuardedPathMotion(self, motion, plan, watch))
 
     def dock(self) -> Motion:
         if self.is_docked():

@@ -4,13 +4,18 @@ Why here and not on the sim thread: planning is pure (navigation.planner) and ta
 to tens of them; run on the goal's executor thread it never stalls physics. The map is the one the
 robot believes (the world file as the robot knows it, not the disturbed truth), published once and
 latched (transient local), as map_server does; the planning map, inflated by the robot's turning
-circle, goes out the same way on /global_costmap/costmap. Frames: ``map`` (the world frame; the
+circle, goes out the same way on /global_costmap/costmap. Things not on the map: the drive is
+watched by the base laser (physics.guarded_path); stopped short of an obstacle, the robot marks
+what it saw on a local copy of the map (this goal only; /map stays the static map) and plans again
+from its pose estimate; with no way round it waits and re-tries (a fresh scan forgets marks it
+now sees through) for BLOCKED_TIMEOUT_S of simulated time. Frames: ``map`` (the world frame; the
 base pose estimate is in it). Lives on: rclpy executor threads (goals, one at a time).
 """
 
 from __future__ import annotations
 
 import logging
+import time
 from typing import Any
 
 import numpy as np
@@ -22,14 +27,22 @@ from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 from tiago_sim.lab.world import World
+from tiago_sim.navigation.blockage import UnmappedObstacles, marks, still_there
 from tiago_sim.navigation.occupancy_map import OccupancyMap, build_map
 from tiago_sim.navigation.planner import GlobalPlanner, Plan, PlanningError
+from tiago_sim.physics.guarded_path import PATH_BLOCKED, scan_in_map
 from tiago_sim.sim_node.action_run import ActionAbort, ActionRun
 from tiago_sim.sim_node.publishers import stamp_of
 
 log = logging.getLogger(__name__)
 
 MAP_FRAME = "map"
+BLOCKED_TIMEOUT_S = 20.0
+"""Simulated seconds the robot waits for a path while obstacles not on the map leave none (a
+person or a trolley in a corridor usually moves on within that), then the goal fails."""
+RETRY_PERIOD_S = 2.0
+"""While blocked: a fresh scan and a new plan this often (simulated seconds)."""
+_WAIT_POLL_S = 0.02
 OCCUPIED, FREE = 100, 0  # nav_msgs/OccupancyGrid: probability in percent; the map knows every cell
 
 
@@ -85,6 +98,7 @@ class Navigation:
         self.plan_pub = node.create_publisher(Path, "/plan", latched)
         self.map_pub.publish(grid_message(self.static_map, stamp_of(0.0)))
         self.costmap_pub.publish(grid_message(self.planner.inflated, stamp_of(0.0)))
+        self.unmapped = UnmappedObstacles(self.static_map)
         self.last_plan: Plan | None = None
 
     def drive(
@@ -96,22 +110,91 @@ class Navigation:
         span: tuple[float, float] = (0.0, 1.0),
         later_s: float = 0.0,
     ) -> Any:
-        """Plan from the pose estimate to `goal`, publish the plan, follow it; NAVIGATION_FAILED
-        (naming why) when no path exists."""
-        start = run.sim(lambda sim: sim.pose_estimate())
-        try:
-            plan = self.planner.plan(start, goal)
-        except PlanningError as error:
-            raise ActionAbort(
-                ErrorCodes.NAVIGATION_FAILED, f"no path to {goal_name}: {error.reason}"
-            ) from None
+        """Plan from the pose estimate to `goal`, publish the plan, follow it while the laser
+        watches the corridor ahead; stopped short of an obstacle not on the map, mark it on a local
+        copy of the map and plan again from where the robot stands. NAVIGATION_FAILED (naming why)
+        when no path exists on the static map, or when obstacles not on the map leave none for
+        BLOCKED_TIMEOUT_S of simulated time (re-tried every RETRY_PERIOD_S meanwhile)."""
+        seen = np.zeros((0, 2))  # obstacles not on the map, seen during this goal (map frame)
+        blocked_since: float | None = None
+        while True:
+            start = run.sim(lambda sim: sim.pose_estimate())
+            try:
+                plan = self._plan(start, goal, seen)
+            except PlanningError as error:
+                if not len(seen):
+                    raise ActionAbort(
+                        ErrorCodes.NAVIGATION_FAILED, f"no path to {goal_name}: {error.reason}"
+                    ) from None
+                now = run.sim_thread.sim_time
+                blocked_since = now if blocked_since is None else blocked_since
+                what = f"an obstacle not on the map near {_near_text(seen, start)}"
+                if now - blocked_since >= BLOCKED_TIMEOUT_S:
+                    raise ActionAbort(
+                        ErrorCodes.NAVIGATION_FAILED,
+                        f"no path to {goal_name}: blocked by {what} for {BLOCKED_TIMEOUT_S:.0f} s "
+                        f"(simulated): {error.reason}",
+                    ) from None
+                left_s = BLOCKED_TIMEOUT_S - (now - blocked_since)
+                phase = f"waiting: the path to {goal_name} is blocked by {what}; re-trying for {left_s:.0f} s"
+                self._wait(run, phase, RETRY_PERIOD_S, span[0] + (span[1] - span[0]) * run_share(run, span))
+                scan = run.sim(scan_in_map)  # forget what is gone, add what is new
+                kept = still_there(seen, scan.points, scan.origin, scan.beam_rad)
+                seen = np.vstack([kept, self.unmapped.near_robot(scan.points, scan.pose[:2])])
+                continue
+            blocked_since = None
+            self.last_plan = plan
+            self.plan_pub.publish(path_message(plan, goal[2], start[2], stamp_of(run.sim_thread.sim_time)))
+            started: list[Any] = []
+
+            def follow(sim: Any, plan: Plan = plan, started: list[Any] = started) -> Any:
+                started.append(sim.follow_path(plan, goal[2], watch=self.unmapped))
+                return started[-1]
+
+            try:
+                return run.run_motion(follow, span=span, later_s=later_s)
+            except ActionAbort as abort:
+                if abort.code != PATH_BLOCKED:
+                    raise
+                log.info("%s; planning again around it", abort.message)
+                seen = np.vstack([seen, started[-1].seen])
+
+    def _plan(
+        self, start: tuple[float, float, float], goal: tuple[float, float, float], seen: np.ndarray
+    ) -> Plan:
+        """A plan on the static map, or on a local copy with the seen obstacles marked."""
+        local = self.static_map.with_footprints(marks(seen)) if len(seen) else None
+        planner = self.planner if local is None else GlobalPlanner(local)
+        plan = planner.plan(start, goal)
         log.info(
-            "plan to %s: %d waypoints, %.2f m, %.1f ms",
-            goal_name,
+            "plan: %d waypoints, %.2f m, %.1f ms%s",
             len(plan.waypoints),
             plan.length_m,
             plan.planning_s * 1000,
+            f" ({len(seen)} points not on the map marked)" if len(seen) else "",
         )
-        self.last_plan = plan
-        self.plan_pub.publish(path_message(plan, goal[2], start[2], stamp_of(run.sim_thread.sim_time)))
-        return run.run_motion(lambda sim: sim.follow_path(plan, goal[2]), span=span, later_s=later_s)
+        return plan
+
+    @staticmethod
+    def _wait(run: ActionRun, phase: str, duration_s: float, progress: float) -> None:
+        """Stand for `duration_s` of simulated time, sending feedback that says why; cancellable."""
+        until = run.sim_thread.sim_time + duration_s
+        run.feedback(progress, phase, duration_s, force=True)
+        while run.sim_thread.sim_time < until:
+            if run.sim_thread.stopped:
+                raise ActionAbort(ErrorCodes.INTERNAL, "simulation stopped")
+            run.check_cancel()
+            run.feedback(progress, phase, until - run.sim_thread.sim_time)
+            time.sleep(_WAIT_POLL_S)
+
+
+def run_share(run: ActionRun, span: tuple[float, float]) -> float:
+    """The share of `span` the goal's progress has reached (0..1)."""
+    low, high = span
+    return min(max((run.progress - low) / max(high - low, 1e-9), 0.0), 1.0)
+
+
+def _near_text(points: np.ndarray, pose: tuple[float, float, float]) -> str:
+    """Where the nearest seen point is, in words."""
+    nearest = points[int(np.argmin(np.hypot(*(points - np.array(pose[:2])).T)))]
+    return f"({nearest[0]:.2f}, {nearest[1]:.2f})"

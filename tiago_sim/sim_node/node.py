@@ -16,7 +16,9 @@ ROS parameters (changeable at runtime): ``pois.<name>`` = [x, y, yaw] (from the 
 (empty: none); ``fault.remove_plate``: a plate id taken away onto the floor far from every station;
 ``fault.drop_plate``: a plate id that slips out of the hotel during the next drive;
 ``fault.knock_plate``: a plate id taken away the moment the gripper releases it in a nest. Setting
-any plate fault to empty puts faulted plates back at their world-file nests.
+any plate fault to empty puts faulted plates back at their world-file nests. ``fault.block_path``:
+a box not on the map appears on the path during the next drive, "1.0" m ahead of the base, or
+"closed" / "closed:1.5" as a floor-wide wall (tiago_sim.measuring.path_blocker); empty removes it.
 """
 
 from __future__ import annotations
@@ -39,6 +41,7 @@ from rclpy.parameter import Parameter
 from labware_model.holders import UNKNOWN, Nest, location_text
 from tiago_sim.lab.world import DEFAULT_WORLD, World, WorldError, load_world
 from tiago_sim.measuring.fault_injection import Occluders, PlateFaults
+from tiago_sim.measuring.path_blocker import PathBlocker, parse_block_path
 from tiago_sim.node_main import spin_node
 from tiago_sim.robot.motion_library import DEFAULT_MOTIONS_FILE, load_motions
 from tiago_sim.sim_node.action_servers import RobotActionServers
@@ -66,6 +69,8 @@ class SimNode:
         self.sim_thread = sim_thread
         self.occluders = Occluders(world)
         self.plate_faults = PlateFaults()
+        self.navigation = Navigation(node, world)
+        self.path_blocker = self._path_blocker()
         self._declare_parameters()
         motions = load_motions(motions_file)
         self.behaviours = RobotBehaviours(
@@ -75,7 +80,7 @@ class SimNode:
             hotel_slots=world.hotel_slots,
             motions=motions,
             speed_scale=lambda: float(node.get_parameter("speed_scale").value),
-            navigation=Navigation(node, world),
+            navigation=self.navigation,
         )
         self.marker_motion = MarkerMotionBehaviour(world, self.behaviours, motions.hotel)
         self.actions = RobotActionServers(
@@ -116,6 +121,7 @@ class SimNode:
         self.node.declare_parameter("fault.remove_plate", "")
         self.node.declare_parameter("fault.drop_plate", "")
         self.node.declare_parameter("fault.knock_plate", "")
+        self.node.declare_parameter("fault.block_path", "")
 
     def _on_parameters(self, parameters: list[Parameter]) -> SetParametersResult:
         for parameter in parameters:
@@ -131,6 +137,11 @@ class SimNode:
                 and value not in {s.name for s in self.world.stations}
             ):
                 return SetParametersResult(successful=False, reason=f"unknown station {value!r}")
+            if name == "fault.block_path":
+                try:
+                    parse_block_path(str(value))
+                except ValueError as error:
+                    return SetParametersResult(successful=False, reason=str(error))
             plates = {plate.labware_id for plate in self.world.plates}
             if name in PLATE_FAULTS and value and value not in plates:
                 return SetParametersResult(successful=False, reason=f"unknown plate {value!r}")
@@ -146,6 +157,8 @@ class SimNode:
         elif name == "fault.occlude_marker":
             station = str(value)
             self.sim_thread.call(lambda sim: self.occluders.set_occluded(sim, station))
+        elif name == "fault.block_path":
+            self.sim_thread.run(lambda sim: self._apply_block_path(sim, str(value)))
         elif name in PLATE_FAULTS:
             self.sim_thread.run(lambda sim: self._apply_plate_fault(sim, name, str(value)))
         elif name.startswith("stations.") and name.endswith(".approach_height_m"):
@@ -171,6 +184,17 @@ class SimNode:
             # under CI load: a 1 s drive went by without the check seeing the base at speed).
             self.sim_thread.watch(self.plate_faults.drop_if_driving)
 
+    def _path_blocker(self) -> PathBlocker:
+        return PathBlocker(self.world.floor_size, lambda: self.navigation.last_plan)
+
+    def _apply_block_path(self, sim: Any, value: str) -> None:
+        request = parse_block_path(value)
+        if request is None:
+            self.path_blocker.clear(sim)
+            return
+        self.path_blocker.arm(sim, request)
+        self.sim_thread.watch(self.path_blocker.watch)
+
     def _forget_the_old_lab(self) -> None:
         """After a reset: localisation starts again at the dock on the new Simulation; no fault
         stands, no grasp is remembered, no error shows."""
@@ -178,9 +202,12 @@ class SimNode:
         self.publishers.localisation = self.localisation
         self.occluders = Occluders(self.world)
         self.plate_faults = PlateFaults()
+        self.path_blocker.request, self.path_blocker.body = None, -1  # its box went with the old Simulation
+        self.path_blocker = self._path_blocker()
         self.node.set_parameters(
             [
                 Parameter("fault.occlude_marker", value=""),
+                Parameter("fault.block_path", value=""),
                 *(Parameter(name, value="") for name in PLATE_FAULTS),
             ]
         )

@@ -91,11 +91,28 @@ def test_reset_and_remove_are_refused_while_the_robot_drives(cell: Cell) -> None
     reset(cell)
 
 
+def test_a_path_closed_mid_drive_fails_the_drive_with_navigation_failed(cell: Cell) -> None:
+    lab = lab_controls(cell)
+    motion = cell.robot.MobileRobotController
+    finish(motion.Undock())
+    lab.SetPace(Pace=10.0)  # the robot waits 20 s of simulated time for a way round
+    lab.InjectFault(Fault="BlockPath", Target="closed")  # meant to strike during a command
+    assert lab.ActiveFaults.get() == ["BlockPath closed"]
+    drive = motion.DriveToPointOfInterest(PointOfInterest="station_b_work")
+    with pytest.raises(DefinedExecutionError, match="NavigationFailed") as failure:
+        finish(drive)
+    assert "blocked by an obstacle not on the map" in str(failure.value)
+    lab.ClearFaults()
+    lab.SetPace(Pace=0.0)
+    reset(cell)
+
+
 @pytest.mark.parametrize(
     ("fault", "target", "named"),
     [
         ("RemovePlate", "no_such_plate", "no_such_plate"),
         ("OccludeMarker", "station_z", "station_z"),
+        ("BlockPath", "sideways", "sideways"),
         ("Explode", PLATE, "Explode"),
     ],
 )

@@ -78,8 +78,12 @@ class SimulatedLabControllerClient:
         floor, far from every station; out of the gripper too). DropPlate makes the named plate slip out of the
         robot's hotel during the next drive. KnockPlate takes the named plate away the moment the gripper
         releases it into a nest. OccludeMarker hides the named station's marker behind a panel until the
-        faults are cleared. Refused while a robot command runs, except OccludeMarker, DropPlate and KnockPlate,
-        which are meant to strike during one.
+        faults are cleared. BlockPath puts a box that is not on the robot's map across its path during the next
+        drive, its near side Target metres ahead of the robot along the path ("1.0"), or a wall across the whole
+        lab there ("closed": 1.0 m ahead, "closed:1.5"); the robot sees it with its base laser, stops short of it
+        and drives around it, or, with no way round for 20 s, fails the navigation (NavigationFailed). It stands
+        until the faults are cleared. Refused while a robot command runs, except OccludeMarker, DropPlate,
+        KnockPlate and BlockPath, which are meant to strike during one.
 
         """
         ...
@@ -87,8 +91,9 @@ class SimulatedLabControllerClient:
     def ClearFaults(self, *, metadata: Optional[Iterable[ClientMetadataInstance]] = None) -> ClearFaults_Responses:
         """
 
-        Ends every standing fault: an occluded marker shows again, armed drops and knocks are disarmed, and plates
-        the faults took away go back to their world-file places where those are free.
+        Ends every standing fault: an occluded marker shows again, armed drops and knocks are disarmed, a box
+        blocking the path goes, and plates the faults took away go back to their world-file places where those
+        are free.
 
         """
         ...
