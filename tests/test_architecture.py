@@ -26,6 +26,14 @@ ALLOWED: dict[str, set[str]] = {
     "tiago_sim.robot": {"tiago_sim.transforms"},
     "tiago_sim.perception": {"tiago_sim.transforms"},
     "tiago_sim.navigation": {"labware_model", "tiago_sim.transforms", "tiago_sim.lab", "tiago_sim.robot"},
+    # `world check`: the loader's rules, the planner's paths between POIs, the picture
+    "tiago_sim.inspection": {
+        "labware_model",
+        "tiago_sim.transforms",
+        "tiago_sim.lab",
+        "tiago_sim.robot",
+        "tiago_sim.navigation",
+    },
     # random labs for campaigns: world files checked by the lab's loader
     "tiago_sim.layouts": {"tiago_sim.transforms", "tiago_sim.lab", "tiago_sim.robot"},
     "tiago_sim.physics": {

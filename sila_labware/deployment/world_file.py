@@ -14,7 +14,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-WORLD_CHECK_MODULE = "tiago_sim.lab.world_check"
+WORLD_CHECK_MODULE = "tiago_sim.inspection.world_check"
 CHECK_TIMEOUT_S = 60.0
 
 

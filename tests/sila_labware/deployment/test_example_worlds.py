@@ -20,7 +20,8 @@ EXPECTED = {
     "bench_in_the_way": ("plate_001", "station_a/1", "station_b/1"),  # around bench_c, untouched
     "furnished_lab": ("plate_001", "station_a/1", "station_b/1"),  # around a pillar and a cart
     "two_benches": ("plate_b", "bench_a/2", "bench_b/1"),
-    "three_stations": ("mp_001", "reader/1", "incubator/1"),
+    "three_stations": ("dw_001", "sealer/1", "reader/2"),  # the deep-well plate
+    "four_nests": ("plate_001", "reader/1", "plate_store/4"),  # the far end of the arm's band
 }
 
 

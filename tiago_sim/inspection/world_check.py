@@ -1,8 +1,11 @@
-"""`python -m tiago_sim.lab.world_check FILE [--png OUT]`: is a world file valid, and what is in it.
+"""`python -m tiago_sim.inspection.world_check FILE [--png OUT]`: is a world file valid, and what is in it.
 
 Why a command: a technician editing a lab file wants every problem at once before starting the
-robot, and a look at the layout. `sila-labware world check` runs this module (and `serve`/`demo`
-run it before they start anything): the SiLA side does not import the simulation's packages.
+robot, and a look at the layout. Besides the loader's rules it plans a path between every pair of
+POIs on the robot's own inflated map (tiago_sim.navigation): a POI the robot cannot reach is a
+problem of the file too, found here rather than by a transfer minutes later.
+`sila-labware world check` runs this module (and `serve`/`demo` run it before they start
+anything): the SiLA side does not import the simulation's packages.
 
 Exit codes: 0 valid, 1 invalid (every problem on stderr, one per line: `file: field: problem`),
 2 bad usage.
@@ -17,14 +20,25 @@ from pathlib import Path
 from typing import TextIO
 
 from labware_model.holders import HotelSlot, Nest
+from tiago_sim.inspection.poi_paths import PoiPaths, plan_poi_paths
 from tiago_sim.lab.world import World, WorldError, load_world
 
 INVALID_WORLD_EXIT_CODE = 1
 
 
-def summary(world: World) -> str:
+def _paths_line(paths: PoiPaths) -> str:
+    planned = [path for path in paths.paths if path.plan is not None]
+    line = f"paths: {len(planned)} of {len(paths.paths)} POI pairs planned"
+    if planned:
+        longest = max(planned, key=lambda path: path.plan.length_m)
+        line += f", longest {longest.plan.length_m:.2f} m ({longest.start} -> {longest.goal})"
+    missing = len(paths.paths) - len(planned)
+    return line + (f"; {missing} without a path" if missing else "; every POI reachable from every other")
+
+
+def summary(world: World, paths: PoiPaths) -> str:
     """A short table: the stations with marker, nests, POI and plates; the other POIs; labware types;
-    obstacles."""
+    obstacles; the planned paths."""
     plates_at: dict[str, list[str]] = {}
     aboard = []
     for plate, holder in world.plates.items():
@@ -57,6 +71,7 @@ def summary(world: World) -> str:
         )
         where = f"({obstacle.x:g}, {obstacle.y:g})"
         lines.append(f"obstacle {obstacle.name}: {outline}, {obstacle.height:g} m tall, at {where}")
+    lines.append(_paths_line(paths))
     return "\n".join(lines) + "\n"
 
 
@@ -67,13 +82,16 @@ def check_world(path: Path, png: Path | None, out: TextIO, err: TextIO) -> int:
     except WorldError as error:
         err.write("".join(f"{line}\n" for line in error.problems))
         return INVALID_WORLD_EXIT_CODE
-    out.write(summary(world))
-    if png is not None:
-        from tiago_sim.lab.world_picture import draw_world  # matplotlib: only when drawing
+    paths = plan_poi_paths(world)
+    out.write(summary(world, paths))
+    if png is not None:  # drawn even when a path is missing: the picture shows where
+        from tiago_sim.inspection.world_picture import draw_world  # matplotlib: only when drawing
 
-        draw_world(world, png)
+        draw_world(world, png, paths)
         out.write(f"picture: {png}\n")
-    return 0
+    problems = paths.problems(str(path))
+    err.write("".join(f"{line}\n" for line in problems))
+    return INVALID_WORLD_EXIT_CODE if problems else 0
 
 
 def main(argv: Sequence[str] | None = None) -> int:

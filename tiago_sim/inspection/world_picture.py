@@ -2,10 +2,10 @@
 
 Why: a world file is a list of poses in three frames; a mistake (a bench turned the wrong way, a
 marker facing the wall, a POI whose turning circle reaches into a bench) is obvious in a picture
-and easy to miss in the numbers. The robot drives straight from POI to POI and turns on the spot at
-each, so the picture draws at every POI the base footprint and the circle the onboard hotel tray
-sweeps when the robot turns; and the free-standing obstacles. Matplotlib's Agg canvas only
-(headless, no pyplot state).
+and easy to miss in the numbers. The picture draws at every POI the base footprint and the circle
+the robot sweeps when it turns there, the free-standing obstacles, and the paths the global planner
+finds between the POIs (those the robot drives, on the map it drives on), with a red dashed line
+where there is none. Matplotlib's Agg canvas only (headless, no pyplot state).
 """
 
 from __future__ import annotations
@@ -20,14 +20,15 @@ from matplotlib.patches import Circle, Polygon
 
 from labware_model.holders import Nest
 from tiago_sim import transforms as tf
+from tiago_sim.inspection.poi_paths import PoiPaths
 from tiago_sim.lab.world import Pose2D, Station, World
+from tiago_sim.navigation.planner import ROBOT_RADIUS_M
+from tiago_sim.robot.robot_model import BASE_RADIUS
 
-BASE_RADIUS_M = 0.265
-"""TIAGo's base (tiago_sim.robot.robot_model.BASE_RADIUS; the lab layer does not import the robot)."""
-HOTEL_SWEEP_RADIUS_M = 0.48
-"""The robot's farthest point from the base centre in the travel pose: the folded arms
-(navigation.planner.ARM_SWEEP_RADIUS_M; the hotel tray's corner is at 0.354 m): the circle it
-sweeps in a turn."""
+BASE_RADIUS_M = BASE_RADIUS
+SWEEP_RADIUS_M = ROBOT_RADIUS_M
+"""The robot's farthest point from the base centre in the travel pose (the folded arms; the hotel
+tray's corner is nearer): the circle it sweeps in a turn, as the planner inflates by."""
 ARROW_M = 0.35
 PLATE_COLOURS = ("tab:orange", "tab:purple", "tab:cyan", "tab:olive", "tab:pink")
 
@@ -49,13 +50,9 @@ def _heading(ax: Axes, pose: Pose2D, colour: str, length: float = ARROW_M) -> No
 
 def _robot_at(ax: Axes, pose: Pose2D, name: str, colour: str) -> None:
     ax.add_patch(Circle((pose.x, pose.y), BASE_RADIUS_M, facecolor=colour, alpha=0.25, edgecolor=colour))
-    ax.add_patch(
-        Circle((pose.x, pose.y), HOTEL_SWEEP_RADIUS_M, fill=False, edgecolor=colour, ls="--", lw=0.8)
-    )
+    ax.add_patch(Circle((pose.x, pose.y), SWEEP_RADIUS_M, fill=False, edgecolor=colour, ls="--", lw=0.8))
     _heading(ax, pose, colour)
-    ax.text(
-        pose.x, pose.y - HOTEL_SWEEP_RADIUS_M - 0.05, name, ha="center", va="top", fontsize=7, color=colour
-    )
+    ax.text(pose.x, pose.y - SWEEP_RADIUS_M - 0.05, name, ha="center", va="top", fontsize=7, color=colour)
 
 
 def _station(ax: Axes, world: World, station: Station, nest_size: tuple[float, float]) -> None:
@@ -124,8 +121,19 @@ def _extent(world: World, margin: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
     return centre - side / 2, centre + side / 2
 
 
-def draw_world(world: World, path: Path) -> None:
-    """Write the world's floor plan as a PNG to `path`."""
+def _paths(ax: Axes, world: World, paths: PoiPaths) -> None:
+    """The planned paths between POIs (thin blue), a red dashed straight line where none exists."""
+    for path in paths.paths:
+        if path.plan is None:
+            start, goal = world.pois[path.start], world.pois[path.goal]
+            ax.plot([start.x, goal.x], [start.y, goal.y], color="red", ls="--", lw=1.5)
+        else:
+            xs, ys = zip(*path.plan.waypoints, strict=True)
+            ax.plot(xs, ys, color="tab:blue", lw=0.8, alpha=0.6)
+
+
+def draw_world(world: World, path: Path, paths: PoiPaths | None = None) -> None:
+    """Write the world's floor plan as a PNG to `path`, with the planned paths if given."""
     figure = Figure(figsize=(9, 9), dpi=110)
     ax = figure.add_subplot()
     half = world.floor_size / 2
@@ -136,6 +144,8 @@ def draw_world(world: World, path: Path) -> None:
         clearance = 2 * station.nest_clearance
         _station(ax, world, station, (pocket[0] + clearance, pocket[1] + clearance))
     _obstacles(ax, world)
+    if paths is not None:
+        _paths(ax, world, paths)
     station_pois = {station.poi for station in world.stations}
     for name, pose in world.pois.items():
         if name not in station_pois:
@@ -147,7 +157,8 @@ def draw_world(world: World, path: Path) -> None:
     ax.text(0.01, 0.99, "\n".join(notes), transform=ax.transAxes, fontsize=8, va="top", bbox={"fc": "white"})
     ax.set_title(
         f"{world.name} ({Path(world.source).name}), floor {world.floor_size:g} m\n"
-        "base footprint (filled) and turning sweep (dashed) at each POI; dotted: working pose",
+        "base footprint (filled) and turning sweep (dashed) at each POI; dotted: working pose;\n"
+        "thin blue: planned paths between POIs (red dashed: no path)",
         fontsize=9,
     )
     low, high = _extent(world)
