@@ -23,11 +23,22 @@ class NestReading:
 
 @dataclass(frozen=True)
 class HotelSlotReading:
-    """A hotel pocket's sensor: the plate in it, by id and type name ("" and "" when empty)."""
+    """A hotel pocket's sensors: whether a plate is there (presence) and, when its reader read the
+    label, the plate's id and type name ("" otherwise). An id implies presence."""
 
     slot: HotelSlot
     labware_id: str = ""
     labware_type: str = ""
+    occupied: bool = False
+
+    def __post_init__(self) -> None:
+        if self.labware_id and not self.occupied:
+            object.__setattr__(self, "occupied", True)
+
+    @property
+    def unread(self) -> bool:
+        """A plate is there whose label the reader could not read."""
+        return self.occupied and not self.labware_id
 
 
 @dataclass(frozen=True)

@@ -48,11 +48,12 @@ def robot_status_from_message(message: RobotState) -> RobotStatus:
         y_m=float(message.base_pose.y),
         theta_rad=float(message.base_pose.theta),
         hotel=tuple(
-            HotelSlotReading(HotelSlot(int(slot.index)), slot.labware_id, slot.labware_type)
+            HotelSlotReading(HotelSlot(int(slot.index)), slot.labware_id, slot.labware_type, slot.occupied)
             for slot in message.hotel
         ),
         held_labware_id=message.held_labware_id,
         stamp_s=message.stamp.sec + message.stamp.nanosec * 1e-9,
+        holding=message.holding,
     )
 
 

@@ -31,10 +31,16 @@ class RobotStatus:
     held_labware_id: str
     stamp_s: float = 0.0
     """The message stamp in seconds: the robot side's clock (simulated time in simulation)."""
+    holding: bool = False
+    """The gripper holds a plate (presence), read or not; a held id implies it."""
 
     # the state words of labware_interfaces/RobotState
     DOCKED: ClassVar[str] = "docked"
     IDLE: ClassVar[str] = "idle"
+
+    def __post_init__(self) -> None:
+        if self.held_labware_id and not self.holding:
+            object.__setattr__(self, "holding", True)
 
     @property
     def docked(self) -> bool:

@@ -31,14 +31,21 @@ class LabwareRecord:
     location: Location
 
 
+def unread_in_slot(robot_status: RobotStatus, slot: HotelSlot | None) -> bool:
+    """The hotel slot's presence sensor sees a plate whose label its reader could not read."""
+    return slot is not None and any(r.slot == slot and r.unread for r in robot_status.hotel)
+
+
 def observed_location(
     labware_id: str,
     handover: Nest | None,
     robot_status: RobotStatus,
     nests: Iterable[NestReading],
+    slot: HotelSlot | None = None,
 ) -> Location:
-    """Where the observations put a plate: robot hotel, gripper, a nest reporting it, or the
-    hand-over nest if its sensor sees a plate without an id; otherwise unknown."""
+    """Where the observations put a plate: robot hotel, gripper, a nest reporting it; else, where
+    a sensor sees a plate without reading its label, the transfer's own holders: its hotel slot, the
+    gripper (it carries one plate at most), its hand-over nest; otherwise unknown."""
     for reading in robot_status.hotel:
         if reading.labware_id == labware_id:
             return reading.slot
@@ -48,6 +55,14 @@ def observed_location(
     for reading in nests:
         if reading.occupied and reading.labware_id == labware_id:
             return reading.nest
+    if slot is not None and unread_in_slot(robot_status, slot):
+        return slot
+    if (
+        (slot is not None or handover is not None)
+        and robot_status.holding
+        and not robot_status.held_labware_id
+    ):
+        return GRIPPER
     if handover is not None:
         for reading in nests:
             if reading.nest == handover and reading.occupied and not reading.labware_id:
@@ -109,9 +124,11 @@ class Inventory:
         handover: Nest | None,
         robot_status: RobotStatus,
         nests: Iterable[NestReading],
+        slot: HotelSlot | None = None,
     ) -> Location:
-        """Record where the observations put the plate (after a transfer, whatever its outcome)."""
-        location = observed_location(labware_id, handover, robot_status, nests)
+        """Record where the observations put the plate (after a transfer, whatever its outcome; `slot`:
+        the transfer's hotel slot)."""
+        location = observed_location(labware_id, handover, robot_status, nests, slot)
         self.record(labware_id, labware_type, location)
         return location
 

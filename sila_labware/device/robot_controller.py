@@ -40,7 +40,7 @@ from ros_bridge.workcell import LabwareHandover, RobotStatus
 from sila_labware.device.cancellation import CancelToken
 from sila_labware.device.errors import CommandSequenceError, MotionFailed, TransferFailed
 from sila_labware.device.goal_runner import ControllerWaits, GoalRunner
-from sila_labware.device.inventory import Inventory
+from sila_labware.device.inventory import Inventory, unread_in_slot
 from sila_labware.device.robot_backend import RobotBackend
 from sila_labware.device.sequences import ManipulatorSequence, PreparedTransfer
 from sila_labware.device.validation import DeviceParameters
@@ -106,9 +106,9 @@ class RobotController:
         )
         occupant = self._hotel_occupant(self.link.robot_status(), internal_position)
         if occupant is not None:
+            what = f"labware {occupant!r}" if occupant else "a plate whose label its reader could not read"
             raise CommandSequenceError(
-                f"PrepareForInput refused: internal position {internal_position} already holds "
-                f"labware {occupant!r}"
+                f"PrepareForInput refused: internal position {internal_position} already holds {what}"
             )
         transfer = PreparedTransfer(handover, internal_position, labware_type, labware_id)
         self.sequence.begin_prepare_for_input(transfer)
@@ -120,6 +120,14 @@ class RobotController:
         """Robot will hand a plate to `position`: the hotel slot must hold one; drive there."""
         handover = self.parameters.prepare(position, sub_position, internal_position)
         occupant = self._hotel_occupant(self.link.robot_status(), internal_position)
+        if occupant == "":  # a plate whose label was not read: the one the inventory put there
+            recorded = self.inventory.in_hotel_slot(internal_position)
+            if recorded is None:
+                raise CommandSequenceError(
+                    f"PrepareForOutput refused: internal position {internal_position} holds a plate "
+                    "whose label its reader could not read, and the inventory has no record of one there"
+                )
+            occupant = recorded.labware_id
         if occupant is None:
             raise CommandSequenceError(
                 f"PrepareForOutput refused: internal position {internal_position} holds no labware"
@@ -280,8 +288,10 @@ class RobotController:
             logger.warning("transfer at %s without a labware id: inventory not updated", transfer.handover)
             return None
 
+        slot = HotelSlot(transfer.internal_position)
+
         def shows_outcome(status: RobotStatus) -> bool:
-            aboard = labware_id in status.onboard_labware_ids
+            aboard = labware_id in status.onboard_labware_ids or unread_in_slot(status, slot)
             return aboard == expect_aboard if outcome.success else True
 
         try:
@@ -296,7 +306,7 @@ class RobotController:
             except BridgeTimeout:
                 pass  # the sensors do not show the place: _refuse_unseen_effect says so
         return self.inventory.settle(
-            labware_id, transfer.labware_type, transfer.handover, status, self.link.nest_readings()
+            labware_id, transfer.labware_type, transfer.handover, status, self.link.nest_readings(), slot
         )
 
     def _refuse_unseen_effect(
@@ -328,8 +338,9 @@ class RobotController:
 
     @staticmethod
     def _hotel_occupant(status: RobotStatus, slot: int) -> str | None:
+        """The id of the plate in the slot; "" for a plate its reader could not read; None if empty."""
         for reading in status.hotel:
-            if reading.slot.index == slot and reading.labware_id:
+            if reading.slot.index == slot and reading.occupied:
                 return reading.labware_id
         return None
 

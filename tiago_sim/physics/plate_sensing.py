@@ -110,12 +110,13 @@ class PlateSensing:
         ]
 
     def hotel_readings(self) -> list[HotelSlotReading]:
-        """The id (and the type it names) as the pocket's reader read it; "" when empty or unread."""
+        """The id (and the type it names) as the pocket's reader read it ("" when empty or unread), and
+        whether a plate is there at all (the pocket's presence switch)."""
         result = []
         for slot, present in self._hotel_occupants():
             labware_id = self.readers.report(location_text(slot), present)
             labware_type = self._scene.plate_types[labware_id].name if labware_id else ""
-            result.append(HotelSlotReading(slot, labware_id, labware_type))
+            result.append(HotelSlotReading(slot, labware_id, labware_type, occupied=bool(present)))
         return result
 
     def held_reading(self, side: str, present: str) -> str:

@@ -278,6 +278,12 @@ class Simulation:
         """T_world_bottom of a plate (its bottom face centre): physics ground truth."""
         return self.plate_sensing.plate_bottom(labware_id)
 
+    def gripper_holds(self, arm: str) -> bool:
+        """A plate between that gripper's pads (both touching) or attached: the fingers' presence
+        reading, which needs no label."""
+        gripper = self.grippers[arm]
+        return bool(gripper.touching() or gripper.attached_id)
+
     def held_labware(self, arm: str) -> str:
         """Plate between that gripper's pads (both touching), or the one attached after a verified grasp,
         as the gripper's identity reader read it ("" if its read failed)."""

@@ -153,9 +153,10 @@ def get_plan(
     """Checks, then the steps that take a plate from a station nest into a hotel slot."""
     checked = check_common(goal, workcell)
     slot = hotel_slot_state(robot_state, checked.hotel_slot)
-    if slot is not None and slot.labware_id:
+    if slot is not None and (slot.occupied or slot.labware_id):
+        occupant = slot.labware_id or "a plate whose label its reader could not read"
         raise TaskRefused(
-            ErrorCodes.SLOT_OCCUPIED, f"hotel slot {goal.internal_position} already holds {slot.labware_id}"
+            ErrorCodes.SLOT_OCCUPIED, f"hotel slot {goal.internal_position} already holds {occupant}"
         )
     nest = nest_state(station_states, checked.nest)
     if nest is None or not nest.occupied:
@@ -204,7 +205,7 @@ def put_plan(
             f"destination {goal.handover_position}:{goal.sub_position} is occupied{holder}",
         )
     slot = hotel_slot_state(robot_state, checked.hotel_slot)
-    if slot is None or not slot.labware_id:
+    if slot is None or not (slot.occupied or slot.labware_id):
         raise TaskRefused(ErrorCodes.SLOT_EMPTY, f"hotel slot {goal.internal_position} holds no plate")
     site, hotel = _goal_fields(checked, arm)
     held = Expect(GRIPPER, ErrorCodes.PLATE_SLIPPED)

@@ -21,22 +21,28 @@ def topic_of(expect: Expect) -> str:
 
 def unmet(expect: Expect, labware_id: str, robot_state: Any, station_states: Any) -> str:
     """ "" when the sensor of `expect.holder` shows the plate `labware_id` (any plate when the id is
-    unknown, or when a nest sensor cannot read ids); otherwise what it shows instead."""
+    unknown, or when the holder's reader could not read the label: presence is what the step
+    promised; a label read as another plate is not); otherwise what it shows instead."""
     holder = expect.holder
     if isinstance(holder, Gripper):
-        return _compare("the gripper", "holds", robot_state.held_labware_id, labware_id)
+        present = bool(robot_state.holding or robot_state.held_labware_id)
+        return _compare("the gripper", "holds", present, robot_state.held_labware_id, labware_id)
     if isinstance(holder, HotelSlot):
         slot = hotel_slot_state(robot_state, holder)
-        return _compare(f"the sensor of {holder}", "sees", slot.labware_id if slot else "", labware_id)
+        present = slot is not None and bool(slot.occupied or slot.labware_id)
+        return _compare(
+            f"the sensor of {holder}", "sees", present, slot.labware_id if slot else "", labware_id
+        )
     reading = nest_state(station_states, holder)
-    if reading is None or not reading.occupied:
-        return f"the sensor of nest {holder} sees no plate"
-    return _compare(f"the sensor of nest {holder}", "sees", reading.labware_id or labware_id, labware_id)
+    present = reading is not None and reading.occupied
+    return _compare(
+        f"the sensor of nest {holder}", "sees", present, reading.labware_id if reading else "", labware_id
+    )
 
 
-def _compare(sensor: str, verb: str, seen: str, wanted: str) -> str:
-    if not seen:
+def _compare(sensor: str, verb: str, present: bool, seen: str, wanted: str) -> str:
+    if not present:
         return f"{sensor} {verb} no plate" if verb == "sees" else f"{sensor} {verb} nothing"
-    if wanted and seen != wanted:
+    if seen and wanted and seen != wanted:
         return f"{sensor} {verb} {seen}, not {wanted}"
     return ""

@@ -51,6 +51,7 @@ class RobotSnapshot:
     docked: bool
     hotel: list[HotelSlotReading]
     held_labware_id: str
+    holding: bool = False  # a plate between the pads (presence), read or not
     nests: list[NestReading] = field(default_factory=list)
     true_base_pose: tuple[float, float, float] | None = None  # simulator truth, for measurement only
     pose_estimate: tuple[float, float, float] | None = None  # localised; None: odometry stands for it
@@ -64,6 +65,7 @@ def take_snapshot(sim: Any) -> RobotSnapshot:
     held = ""
     for arm in ("right", "left"):
         held = held or sim.held_labware(arm)
+    holding = any(sim.gripper_holds(arm) for arm in ("right", "left"))
     return RobotSnapshot(
         sim_time=float(sim.sim_time),
         odometry=tuple(float(v) for v in sim.odometry()),
@@ -71,6 +73,7 @@ def take_snapshot(sim: Any) -> RobotSnapshot:
         docked=bool(sim.is_docked()),
         hotel=list(sim.hotel_readings()),
         held_labware_id=held,
+        holding=holding,
         nests=list(sim.nest_readings()),
         true_base_pose=_true_base_pose(sim),
         pose_estimate=tuple(float(v) for v in sim.pose_estimate()),
@@ -212,8 +215,9 @@ class StatePublishers:
             state.state,
             state.detail,
             state.current_poi,
-            tuple(h.labware_id for h in state.hotel),
+            tuple((h.labware_id, h.occupied) for h in state.hotel),
             state.held_labware_id,
+            state.holding,
         )
         now = time.monotonic()
         slow_due = now - self._last_slow_publish >= 0.5
@@ -275,11 +279,15 @@ class StatePublishers:
         message.base_pose = Pose2D(x=x, y=y, theta=yaw)
         message.hotel = [
             HotelSlot(
-                index=reading.slot.index, labware_id=reading.labware_id, labware_type=reading.labware_type
+                index=reading.slot.index,
+                labware_id=reading.labware_id,
+                labware_type=reading.labware_type,
+                occupied=reading.occupied,
             )
             for reading in snapshot.hotel
         ]
         message.held_labware_id = snapshot.held_labware_id
+        message.holding = snapshot.holding or bool(snapshot.held_labware_id)
         return message
 
     @staticmethod

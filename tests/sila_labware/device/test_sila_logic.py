@@ -196,6 +196,18 @@ def test_observed_location_prefers_robot_reports_then_nest_sensors() -> None:
     assert observed_location("P1", RACK_2, robot_status(), (NestReading(RACK_2, False, ""),)) == UNKNOWN
 
 
+def test_a_plate_whose_label_was_not_read_is_where_its_transfer_put_it() -> None:
+    unread_slot = (HotelSlotReading(HotelSlot(1), "", "", occupied=True), HotelSlotReading(HotelSlot(2)))
+    stowed = RobotStatus("idle", "", "", 0.0, 0.0, 0.0, unread_slot, "")
+    empty_nest = (NestReading(READER, False, ""),)
+    # after a GetLabware into slot 1: the slot sees a plate it could not read, and it is the one moved
+    assert observed_location("P1", READER, stowed, empty_nest, HotelSlot(1)) == HotelSlot(1)
+    assert observed_location("P1", READER, stowed, empty_nest, HotelSlot(2)) == UNKNOWN
+    held = RobotStatus("idle", "", "", 0.0, 0.0, 0.0, (), "", holding=True)
+    assert observed_location("P1", READER, held, empty_nest, HotelSlot(1)) == GRIPPER
+    assert observed_location("P1", None, held, empty_nest) == UNKNOWN  # no transfer: no guess
+
+
 def test_inventory_stays_true_on_failure_and_notifies_changes() -> None:
     inventory = Inventory()
     snapshots: list[int] = []

@@ -55,7 +55,9 @@ def test_work_poi_stands_in_front_of_the_nests_facing_them(world_file):
         for sub in range(1, station.sub_positions + 1):
             T_base_site = tf.invert(T_world_base) @ station.T_world_site(sub)
             assert 0.55 <= T_base_site[0, 3] <= 0.80  # the POI: behind the working pose (0.45 .. 0.55)
-            assert -0.45 - 1e-9 <= T_base_site[1, 3] <= 1e-9  # the right arm's band: 0 .. 0.45 m right of the base
+            assert (
+                -0.45 - 1e-9 <= T_base_site[1, 3] <= 1e-9
+            )  # the right arm's band: 0 .. 0.45 m right of the base
             assert T_base_site[2, 3] == pytest.approx(station.table_size[2])
 
 

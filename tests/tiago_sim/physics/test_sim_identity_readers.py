@@ -63,9 +63,11 @@ def test_unread_plates_are_present_without_an_id_and_physics_still_locates_them(
         script.run(sim.move_tool(ARM, script.grasp(T_base_site, CARRY)), "lift")
         assert sim.grippers[ARM].attached_id == PLATE
         assert sim.held_labware(ARM) == ""  # the gripper's reader failed too
+        assert sim.gripper_holds(ARM)  # but the fingers know they hold something
         T_base_slot = sim.kinematics.forward(sim.joint_positions(), "hotel_slot_1")
         script.place(T_base_slot)
         assert [reading.labware_id for reading in sim.hotel_readings()] == ["", ""]
+        assert [reading.occupied for reading in sim.hotel_readings()] == [True, False]  # presence
         assert sim.check_placement(PLATE).location.index == 1  # type: ignore[union-attr]
     finally:
         sim.close()

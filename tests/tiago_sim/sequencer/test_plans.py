@@ -15,16 +15,26 @@ from labware_interfaces.msg import ErrorCodes, HotelSlot, NestState, RobotState,
 from labware_model.holders import GRIPPER, Nest
 from labware_model.holders import HotelSlot as Slot
 from labware_model.workcell import StationDescription, WorkcellDescription
-from tiago_sim.sequencer.plans import Expect, get_plan, put_plan, retreat_steps
+from tiago_sim.sequencer.plans import Expect, TaskRefused, get_plan, put_plan, retreat_steps
 from tiago_sim.sequencer.postconditions import topic_of, unmet
 
 WORKCELL = WorkcellDescription((StationDescription("station_a", 2, "station_a_work"),), 2, (), "dock")
 A1 = Nest("station_a", 1)
 
 
-def robot(hotel: dict[int, str] | None = None, held: str = "", poi: str = "station_a_work") -> RobotState:
-    slots = [HotelSlot(index=i, labware_id=plate) for i, plate in (hotel or {1: "", 2: ""}).items()]
-    return RobotState(state="idle", current_poi=poi, hotel=slots, held_labware_id=held)
+UNREAD = "?"  # in `hotel`: a plate in the slot whose label the reader could not read
+
+
+def robot(
+    hotel: dict[int, str] | None = None, held: str = "", poi: str = "station_a_work", holding: bool = False
+) -> RobotState:
+    slots = [
+        HotelSlot(index=i, labware_id=plate.strip(UNREAD), occupied=bool(plate))
+        for i, plate in (hotel or {1: "", 2: ""}).items()
+    ]
+    return RobotState(
+        state="idle", current_poi=poi, hotel=slots, held_labware_id=held, holding=holding or bool(held)
+    )
 
 
 def stations(plate: str = "", occupied: bool | None = None) -> StationStates:
@@ -74,6 +84,14 @@ def test_put_checks_the_hotel_before_the_grasp_and_the_nest_after_the_release() 
         (Expect(GRIPPER, "X"), robot(held="P1"), stations(), ""),
         (Expect(GRIPPER, "X"), robot(), stations(), "the gripper holds nothing"),
         (Expect(GRIPPER, "X"), robot(held="P7"), stations(), "the gripper holds P7, not P1"),
+        (Expect(GRIPPER, "X"), robot(holding=True), stations(), ""),  # held, its label unread
+        (Expect(Slot(1), "X"), robot({1: UNREAD, 2: ""}), stations(), ""),  # stowed, label unread
+        (
+            Expect(Slot(1), "X"),
+            robot({1: "P7", 2: ""}),
+            stations(),
+            "the sensor of hotel slot 1 sees P7, not P1",
+        ),
         (Expect(Slot(1), "X"), robot({1: "P1", 2: ""}), stations(), ""),
         (
             Expect(Slot(1), "X"),
@@ -91,6 +109,17 @@ def test_a_post_condition_says_what_the_sensor_saw(
     expect: Expect, robot_state: RobotState, station_states: StationStates, seen: str
 ) -> None:
     assert unmet(expect, "P1", robot_state, station_states) == seen
+
+
+def test_a_plate_whose_label_was_not_read_still_fills_its_hotel_slot() -> None:
+    with pytest.raises(TaskRefused) as refused:
+        get_plan(goal(), WORKCELL, robot({1: UNREAD, 2: ""}), stations("P1"), "right")
+    assert refused.value.code == ErrorCodes.SLOT_OCCUPIED
+    assert "could not read" in str(refused.value)
+    assert put_plan(goal(), WORKCELL, robot({1: UNREAD, 2: ""}), stations(), "right")  # not SLOT_EMPTY
+    with pytest.raises(TaskRefused) as refused:
+        put_plan(goal(), WORKCELL, robot(), stations(), "right")
+    assert refused.value.code == ErrorCodes.SLOT_EMPTY
 
 
 def test_nest_checks_read_the_station_topic_and_the_others_the_robots() -> None:
