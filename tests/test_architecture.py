@@ -34,8 +34,14 @@ ALLOWED: dict[str, set[str]] = {
         "tiago_sim.robot",
         "tiago_sim.navigation",
     },
-    # random labs for campaigns: world files checked by the lab's loader
-    "tiago_sim.layouts": {"tiago_sim.transforms", "tiago_sim.lab", "tiago_sim.robot"},
+    # random labs and obstacles for campaigns: world files checked as the loader and `world check` do
+    "tiago_sim.layouts": {
+        "tiago_sim.transforms",
+        "tiago_sim.lab",
+        "tiago_sim.robot",
+        "tiago_sim.navigation",
+        "tiago_sim.inspection",
+    },
     "tiago_sim.physics": {
         "labware_model",
         "tiago_sim.transforms",

@@ -12,10 +12,8 @@ k of a campaign with seed S uses disturbance seed S + k, so `--replay S+k` runs 
 the same disturbances, not as the same run (the robot side's clock also runs, at 1x wall time,
 while the robot software computes, so a replay's timing and contacts can differ; a failure that
 does not come back on replay is not thereby explained).
-Disturbance levels are sent to the sim node as JSON in SI units (tiago_sim.measuring.disturbances reads
-them); here they are flags in mm, degrees and percent.
-
-Threads: runs on the caller's thread (the CLI's main thread).
+Disturbance levels go to the sim node as JSON in SI units (tiago_sim.measuring.disturbances reads
+them); here they are flags in mm, degrees and percent. Threads: the caller's (the CLI's main thread).
 """
 
 from __future__ import annotations
@@ -146,6 +144,7 @@ class CampaignOptions:
     record_dir: Path | None = None  # frames of the first trial go here
     jobs: int = 1  # trials run side by side, each worker with its own robot side, ports and ROS domain
     layouts_dir: Path | None = None  # random layouts: trial seed S runs in layouts_dir/layout_S.yaml
+    layouts_flag: str = "--random-layouts"  # the bench flag that drew them (for the replay line)
 
 
 def trial_stack(options: CampaignOptions, trial_seed: int, worker: int = 0) -> DeploymentOptions:
@@ -263,7 +262,8 @@ def run_campaign(
 
 def replay_flags(options: CampaignOptions) -> str:
     """What `bench --replay SEED` needs besides the seed to run a trial of this campaign again."""
-    return " --random-layouts" if options.layouts_dir is not None else ""
+    world = f" --world {options.stack.world}" if options.layouts_flag == "--random-obstacles" else ""
+    return f" {options.layouts_flag}{world}" if options.layouts_dir is not None else ""
 
 
 def record_outcome(

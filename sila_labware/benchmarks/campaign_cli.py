@@ -70,11 +70,18 @@ def add_bench_arguments(bench: argparse.ArgumentParser) -> None:
         "failed trials' world files are written next to the --report",
     )
     bench.add_argument(
+        "--random-obstacles",
+        action="store_true",
+        help="the campaign's world (--world) with 1 to 3 random obstacles per trial near its drives, "
+        "drawn from the trial seed; failed trials' world files are written next to the --report",
+    )
+    bench.add_argument(
         "--save-layout",
         nargs=2,
         metavar=("SEED", "FILE"),
         default=None,
-        help="write the random layout of trial seed SEED to FILE (for demo --world) and exit",
+        help="write the random layout of trial seed SEED to FILE (for demo --world) and exit; with "
+        "--random-obstacles, the world with that seed's obstacles",
     )
     bench.add_argument(
         "--jobs",
@@ -109,6 +116,10 @@ def validate_bench(parser: argparse.ArgumentParser, args: argparse.Namespace) ->
         seed, _file = args.save_layout
         if not seed.lstrip("-").isdigit():
             parser.error(f"--save-layout {seed}: the seed is an integer")
+    if args.random_layouts and args.random_obstacles:
+        parser.error(
+            "--random-layouts and --random-obstacles exclude each other (a random lab has no --world)"
+        )
     if args.level_scale < 0:
         parser.error("--level-scale must not be negative")
     for level in LEVEL_FLAGS:
@@ -134,7 +145,8 @@ def bench_command(args: argparse.Namespace, stack: DeploymentOptions) -> int:
         logging.getLogger().setLevel(logging.CRITICAL)
         logging.getLogger("sila_labware").setLevel(logging.WARNING)
     if args.save_layout is not None:
-        return save_layout_command(int(args.save_layout[0]), Path(args.save_layout[1]))
+        furnish = stack.world if args.random_obstacles else None
+        return save_layout_command(int(args.save_layout[0]), Path(args.save_layout[1]), furnish)
     levels = level_values(args)
     first_seed, trials = (args.replay, 1) if args.replay is not None else (args.seed, args.trials)
     frames_dir = args.report / "frames" if args.report is not None else None
@@ -144,32 +156,40 @@ def bench_command(args: argparse.Namespace, stack: DeploymentOptions) -> int:
     jobs = min(args.jobs, trials)
     options = CampaignOptions(stack, first_seed, trials, levels, record_dir=frames_dir, jobs=jobs)
     with tempfile.TemporaryDirectory(prefix="sila-labware-layouts-") as scratch:
-        if args.random_layouts:
+        if args.random_layouts or args.random_obstacles:
+            furnish = stack.world if args.random_obstacles else None
             try:
-                options.layouts_dir = draw_layouts(first_seed, trials, Path(scratch), jobs)
+                options.layouts_dir = draw_layouts(first_seed, trials, Path(scratch), jobs, furnish)
             except LayoutGenerationError as error:
                 sys.stderr.write(f"bench: no random layouts: {error}\n")
                 return 1
+            if args.random_obstacles:
+                options.layouts_flag = "--random-obstacles"
         return _run_and_report(args, options)
 
 
-def draw_layouts(first_seed: int, trials: int, directory: Path, jobs: int) -> Path:
-    """The campaign's random layouts, one per trial seed, written before the first trial."""
+def draw_layouts(
+    first_seed: int, trials: int, directory: Path, jobs: int, furnish: Path | None = None
+) -> Path:
+    """The campaign's random layouts (or `furnish` with random obstacles), one per trial seed,
+    written before the first trial."""
     seeds = list(range(first_seed, first_seed + trials))
-    sys.stderr.write(f"bench: drawing {trials} random layout(s)\n")
-    generate_layouts(seeds, directory, jobs)
+    what = "random layout(s)" if furnish is None else f"obstacle set(s) for {furnish}"
+    sys.stderr.write(f"bench: drawing {trials} {what}\n")
+    generate_layouts(seeds, directory, jobs, furnish)
     return directory
 
 
-def save_layout_command(seed: int, target: Path) -> int:
+def save_layout_command(seed: int, target: Path, furnish: Path | None = None) -> int:
     try:
-        save_layout(seed, target)
+        save_layout(seed, target, furnish)
     except LayoutGenerationError as error:
         sys.stderr.write(f"bench: {error}\n")
         return 1
-    sys.stdout.write(
-        f"{target}: random layout of seed {seed}; run it with sila-labware demo --world {target}\n"
+    what = (
+        f"random layout of seed {seed}" if furnish is None else f"{furnish} with the obstacles of seed {seed}"
     )
+    sys.stdout.write(f"{target}: {what}; run it with sila-labware demo --world {target}\n")
     return 0
 
 
@@ -201,7 +221,10 @@ def _run_and_report(args: argparse.Namespace, options: CampaignOptions) -> int:
     shown_levels = {level.flag.removeprefix("--"): levels[level.field] for level in LEVEL_FLAGS}
     summary = summarize(outcomes, shown_levels, first_seed)
     summary["jobs"] = options.jobs
-    summary["random_layouts"] = options.layouts_dir is not None
+    summary["random_layouts"] = options.layouts_dir is not None and options.layouts_flag == "--random-layouts"
+    summary["random_obstacles"] = (
+        options.layouts_dir is not None and options.layouts_flag == "--random-obstacles"
+    )
     summary["elapsed_wall_seconds"] = elapsed_s  # the trials' own, from the first start to the last stop
     if args.report is not None:
         written = write_charts(summary, args.report)

@@ -1,4 +1,5 @@
-"""`bench --random-layouts` and `bench --save-layout SEED FILE`: a new lab per trial, from its seed.
+"""`bench --random-layouts`, `bench --random-obstacles` and `bench --save-layout SEED FILE`: a new
+lab per trial, from its seed (a random lab, or the campaign's world with random obstacles).
 
 Why child processes: the layouts are drawn and checked on the robot side (`tiago_sim.layouts`,
 the loader's robot checks need the robot model), which the SiLA side does not import; as for
@@ -26,13 +27,24 @@ class LayoutGenerationError(RuntimeError):
     """The layout generator failed (its message is the child's error output)."""
 
 
-def generate_layouts(seeds: Sequence[int], directory: Path, jobs: int = 1) -> None:
-    """Write `directory/layout_SEED.yaml` for every seed, in up to `jobs` children at once."""
+def generate_layouts(
+    seeds: Sequence[int], directory: Path, jobs: int = 1, furnish: Path | None = None
+) -> None:
+    """Write `directory/layout_SEED.yaml` for every seed, in up to `jobs` children at once; with
+    `furnish`, that world with the seed's random obstacles instead of a random lab."""
     directory.mkdir(parents=True, exist_ok=True)
     chunks = [list(seeds[index::jobs]) for index in range(max(1, jobs))]
     children = [
         subprocess.Popen(
-            [sys.executable, "-m", LAYOUT_MODULE, *map(str, chunk), "--out", str(directory)],
+            [
+                sys.executable,
+                "-m",
+                LAYOUT_MODULE,
+                *map(str, chunk),
+                "--out",
+                str(directory),
+                *_furnish(furnish),
+            ],
             stdin=subprocess.DEVNULL,
             stdout=subprocess.DEVNULL,
             stderr=subprocess.PIPE,
@@ -50,10 +62,15 @@ def generate_layouts(seeds: Sequence[int], directory: Path, jobs: int = 1) -> No
         raise LayoutGenerationError("\n".join(errors))
 
 
-def save_layout(seed: int, target: Path) -> None:
-    """Write the random layout `seed` to `target` (the file a --random-layouts trial with that seed runs)."""
+def _furnish(world: Path | None) -> list[str]:
+    return [] if world is None else ["--furnish", str(world)]
+
+
+def save_layout(seed: int, target: Path, furnish: Path | None = None) -> None:
+    """Write the random layout `seed` to `target` (the file a --random-layouts trial with that seed
+    runs; with `furnish`, the world a --random-obstacles trial runs)."""
     done = subprocess.run(
-        [sys.executable, "-m", LAYOUT_MODULE, str(seed), "--file", str(target)],
+        [sys.executable, "-m", LAYOUT_MODULE, str(seed), "--file", str(target), *_furnish(furnish)],
         stdin=subprocess.DEVNULL, capture_output=True, text=True, check=False,
         timeout=60.0 + SECONDS_PER_LAYOUT,
     )  # fmt: skip

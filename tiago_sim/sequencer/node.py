@@ -65,7 +65,7 @@ from tiago_sim.sequencer.plans import (
     retreat_steps,
 )
 from tiago_sim.sequencer.postconditions import topic_of, unmet
-from tiago_sim.sequencer.step_durations import StepDurations
+from tiago_sim.sequencer.step_durations import StepDurations, table_from_parameters
 from tiago_sim.sequencer.task_run import StepFailed, TaskRun
 from tiago_sim.sequencer.waits import describe_workcell, sleep, wait_answering, within
 
@@ -95,8 +95,9 @@ class Sequencer:
         self.node = node
         for name in PARAMETERS:
             node.declare_parameter(name, params[name])
-        for action, seconds in params["estimates_s"].items():
-            node.declare_parameter(f"estimates_s.{action}", float(seconds))
+        self.estimate_keys = tuple(str(key) for key in params["estimates_s"])
+        for key, seconds in params["estimates_s"].items():
+            node.declare_parameter(f"estimates_s.{key}", float(seconds))
         self.clients = {name: ActionClient(node, kind, topic) for name, (kind, topic) in SUB_ACTIONS.items()}
         self.describe_client = node.create_client(DescribeWorkcell, "/describe_workcell")
         self.workcell: WorkcellDescription | None = None
@@ -215,7 +216,9 @@ class Sequencer:
             result.labware_id = labware_id_at_source(
                 goal_handle.request, self.robot_state, self.station_states, from_hotel
             )
-            self.step_durations.table = {a: float(self.param(f"estimates_s.{a}")) for a in SUB_ACTIONS}
+            self.step_durations.table = table_from_parameters(
+                {key: float(self.param(f"estimates_s.{key}")) for key in self.estimate_keys}
+            )
             run = TaskRun(goal_handle, kind.Feedback, plan, [self.step_durations.estimate(s) for s in plan])
             self.active = run
             try:

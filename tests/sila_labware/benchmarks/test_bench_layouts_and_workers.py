@@ -1,6 +1,7 @@
-"""`bench --random-layouts`, `--save-layout` and `--jobs`: a lab per trial seed, the failed trials'
-world files beside the report, workers with ports and ROS domains of their own, outcomes in seed
-order. The campaign runs the real stack on two workers (two short trials: CI has 2 cores)."""
+"""`bench --random-layouts`, `--random-obstacles`, `--save-layout` and `--jobs`: a lab per trial
+seed, the failed trials' world files beside the report, workers with ports and ROS domains of their
+own, outcomes in seed order. The campaign runs the real stack on two workers (two short trials: CI
+has 2 cores)."""
 
 from __future__ import annotations
 
@@ -10,14 +11,21 @@ from pathlib import Path
 
 import yaml
 
-from sila_labware.benchmarks.campaign import CampaignOptions, TrialOutcome, default_level_values, trial_stack
+from sila_labware.benchmarks.campaign import (
+    CampaignOptions,
+    TrialOutcome,
+    default_level_values,
+    replay_flags,
+    trial_stack,
+)
 from sila_labware.benchmarks.random_layouts import keep_failed_layouts
 from sila_labware.deployment.stack import DeploymentOptions
 from tests.sila_labware.benchmarks.test_bench import CLI, run_bench
 from tiago_sim.lab.world import load_world
-from tiago_sim.layouts.layout_file import layout_yaml
+from tiago_sim.layouts.layout_file import furnished_yaml, layout_yaml
 
 SEED = 5150
+DEFAULT_WORLD = Path(__file__).resolve().parents[3] / "tiago_sim" / "worlds" / "default.yaml"
 
 
 def test_each_worker_gets_its_own_ports_and_domain_and_each_trial_its_layout(tmp_path: Path) -> None:
@@ -59,6 +67,42 @@ def test_save_layout_writes_the_trial_seeds_world_file(tmp_path: Path) -> None:
     assert load_world(target).name == f"random layout {SEED}"
 
 
+def test_save_layout_with_random_obstacles_writes_the_world_with_that_seeds_obstacles(tmp_path: Path) -> None:
+    target = tmp_path / "lab.yaml"
+    flags = [
+        "bench",
+        "--random-obstacles",
+        "--world",
+        str(DEFAULT_WORLD),
+        "--save-layout",
+        str(SEED),
+        str(target),
+    ]
+    done = subprocess.run([*CLI, *flags], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert target.read_text() == furnished_yaml(DEFAULT_WORLD, SEED)
+    world, base = load_world(target), load_world(DEFAULT_WORLD)
+    assert world.obstacles and world.stations == base.stations
+
+
+def test_random_layouts_and_random_obstacles_exclude_each_other() -> None:
+    done = subprocess.run(
+        [*CLI, "bench", "--random-layouts", "--random-obstacles"], capture_output=True, text=True, timeout=60
+    )
+    assert done.returncode == 2 and "exclude each other" in done.stderr
+
+
+def test_a_random_obstacles_trial_replays_with_its_world() -> None:
+    stack = DeploymentOptions(world=DEFAULT_WORLD, port_base=57000)
+    options = CampaignOptions(
+        stack, SEED, 1, default_level_values(), layouts_dir=Path("drawn"), layouts_flag="--random-obstacles"
+    )
+    assert replay_flags(options) == f" --random-obstacles --world {DEFAULT_WORLD}"
+    assert replay_flags(CampaignOptions(stack, SEED, 1, default_level_values(), layouts_dir=Path("d"))) == (
+        " --random-layouts"
+    )
+
+
 def test_random_layouts_on_two_workers_report_in_seed_order(tmp_path: Path) -> None:
     report = tmp_path / "report"
     flags = ["--random-layouts", "--trials", "2", "--jobs", "2", "--seed", str(SEED), "--json"]
@@ -84,5 +128,5 @@ def test_random_layouts_on_two_workers_report_in_seed_order(tmp_path: Path) -> N
 def test_bench_help_names_the_layout_and_worker_flags() -> None:
     shown = subprocess.run([*CLI, "bench", "--help"], capture_output=True, text=True, timeout=60)
     text = " ".join(shown.stdout.split())
-    for flag in ("--random-layouts", "--save-layout SEED FILE", "--jobs JOBS"):
+    for flag in ("--random-layouts", "--random-obstacles", "--save-layout SEED FILE", "--jobs JOBS"):
         assert flag in text, flag

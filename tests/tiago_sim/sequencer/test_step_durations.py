@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from tiago_sim.sequencer.plans import Step
-from tiago_sim.sequencer.step_durations import FALLBACK_S, StepDurations, step_kind
+from tiago_sim.sequencer.step_durations import FALLBACK_S, StepDurations, step_kind, table_from_parameters
 
 APPROACH = Step("marker_motion", {"station": "a", "sub_position": 1, "target": "work_pose"})
 TOOL_MOVE = Step("marker_motion", {"station": "a", "sub_position": 1, "target": "site"})
@@ -15,6 +15,24 @@ def test_a_step_kind_names_the_action_and_what_it_does() -> None:
     assert step_kind(APPROACH) == "marker_motion:work_pose"
     assert step_kind(Step("navigate", {"poi": "station_b_work"})) == "navigate:station_b_work"
     assert step_kind(Step("play_motion", {"motion_name": "Tuck"})) == "play_motion:Tuck"
+    # one motion in two parts of a plan: to the hotel from the bench, out of a pocket
+    to_hotel = Step("play_motion", {"motion_name": "NestApproach", "hotel_slot": 1}, "to hotel")
+    retract = Step("play_motion", {"motion_name": "NestApproach", "hotel_slot": 1}, "retract")
+    assert (step_kind(to_hotel), step_kind(retract)) == (
+        "play_motion:NestApproach:to_hotel",
+        "play_motion:NestApproach:retract",
+    )
+
+
+def test_the_table_names_kinds_where_it_can_and_actions_for_the_rest() -> None:
+    table = table_from_parameters({"marker_motion": 2.4, "marker_motion.site.reaching": 1.7})
+    assert table == {"marker_motion": 2.4, "marker_motion:site:reaching": 1.7}
+    durations = StepDurations(table)
+    reaching = Step("marker_motion", {"station": "a", "sub_position": 1, "target": "site"}, "reaching")
+    assert durations.estimate(reaching) == 1.7
+    assert durations.estimate(APPROACH) == 2.4, "a kind the table does not name: its action's value"
+    durations.record(reaching, 2.5)
+    assert durations.estimate(reaching) == 2.5, "what the kind took wins over the table"
 
 
 def test_the_table_serves_until_the_kind_ran_then_what_it_took() -> None:
