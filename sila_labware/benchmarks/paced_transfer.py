@@ -1,6 +1,6 @@
 """One transfer at a set pace, through the Python SiLA client: is a paced robot's timing honest?
 
-    python -m sila_labware.benchmarks.paced_transfer [--pace 1.0] [--world FILE] [--json]
+    python -m sila_labware.benchmarks.paced_transfer [--pace 1.0] [--world FILE] [--json] [--log-dir DIR]
 
 Why: at `--pace 1` a client should see a real robot's timing. Two figures say whether it does:
 - the transfer's wall time against its simulated time (the robot's /robot_state clock): their
@@ -94,10 +94,10 @@ class ProgressSamples:
         return RemainingAtHalfway(step, record.progress, record.remaining_s, ends[0] - wall)
 
 
-def run(world: Path, pace: float, scratch: Path) -> PacedTransferReport:
+def run(world: Path, pace: float, scratch: Path, log_dir: Path | None = None) -> PacedTransferReport:
     """Start a deployment at `pace`, move the first station's plate to the second, measure."""
     options = DeploymentOptions(
-        world=world, port_base=0, ca_file=scratch / "ca.pem", discovery=False, pace=pace
+        world=world, port_base=0, ca_file=scratch / "ca.pem", discovery=False, pace=pace, log_dir=log_dir
     )
     options.port_base = _free_port_base()
     deployment = Deployment(options)
@@ -141,10 +141,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--pace", type=float, default=1.0, help="times real time (default: %(default)s)")
     parser.add_argument("--world", type=Path, default=DEFAULT_WORLD)
     parser.add_argument("--json", action="store_true", help="print one JSON object")
+    parser.add_argument("--log-dir", type=Path, default=None, help="keep the robot side's logs here")
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.WARNING)
     with tempfile.TemporaryDirectory(prefix="sila-labware-paced-") as scratch:
-        report = run(args.world, args.pace, Path(scratch))
+        report = run(args.world, args.pace, Path(scratch), args.log_dir)
     if args.json:
         sys.stdout.write(json.dumps(report.as_json_object()) + "\n")
         return 0

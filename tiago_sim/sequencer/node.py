@@ -212,14 +212,14 @@ class Sequencer:
                 plan = await self._plan(goal_handle.request, make_plan, arrived=time.monotonic())
             except (TaskRefused, StepFailed) as refusal:
                 return self._finish(goal_handle, result, refusal.code, refusal.message)
-            from_hotel = kind is PutLabware
             result.labware_id = labware_id_at_source(
-                goal_handle.request, self.robot_state, self.station_states, from_hotel
+                goal_handle.request, self.robot_state, self.station_states, kind is PutLabware
             )
             self.step_durations.table = table_from_parameters(
                 {key: float(self.param(f"estimates_s.{key}")) for key in self.estimate_keys}
             )
-            run = TaskRun(goal_handle, kind.Feedback, plan, [self.step_durations.estimate(s) for s in plan])
+            durations = [self.step_durations.estimate(step, kind.__name__) for step in plan]
+            run = TaskRun(goal_handle, kind.Feedback, plan, durations, kind.__name__)
             self.active = run
             try:
                 run.publish()
@@ -233,8 +233,10 @@ class Sequencer:
                     if goal_handle.is_cancel_requested:
                         raise StepFailed(ErrorCodes.CANCELED, f"canceled before {step.describe()}")
                     run.publish()  # a new phase is news: clients see it at once, not at the next tick
+                    started = self._robot_seconds()  # a step's time counts its check: clients wait for both
                     await self._run_step(run, step, f"step {index + 1} of {len(plan)}")
                     await self._check_post(step, result.labware_id)
+                    self.step_durations.record(step, self._robot_seconds() - started, run.task)
                 run.index, run.phase = len(plan), "done"
                 run.publish()  # the last word is progress 1.0
                 return self._finish(goal_handle, result, "", "done")
@@ -307,7 +309,6 @@ class Sequencer:
                 run.phase = f"{step.phase}: {message.feedback.phase}"
 
         log.info("%s: %s", which, step.describe())
-        started = self._robot_seconds()
         sent = client.send_goal_async(goal, feedback_callback=on_feedback)
         if not await within(self.node, sent, float(self.param("server_wait_s"))):
             # an answer that comes after all must not leave a goal running that nobody waits for
@@ -333,7 +334,6 @@ class Sequencer:
         if step.expect_holding and not sub_result.holding:
             raise StepFailed(ErrorCodes.GRASP_FAILED, f"{step.describe()}: nothing between the fingers")
         run.step_progress, run.step_remaining_s = 1.0, 0.0
-        self.step_durations.record(step, self._robot_seconds() - started)
 
     def _robot_seconds(self) -> float:
         """The robot's clock as its last state report carried it (simulated time in the twin)."""

@@ -27,15 +27,17 @@ FALLBACK_S = 3.0  # an action the table does not name
 KIND_SEPARATOR_IN_PARAMETERS = "."
 
 
-def step_kind(step: Step) -> str:
-    """The step's action, what it does and its part in the plan, e.g. "marker_motion:work_pose",
-    "play_motion:NestApproach:retract".
+def step_kind(step: Step, task: str = "") -> str:
+    """The task, the step's action, what it does and its part in the plan, e.g.
+    "marker_motion:work_pose", "GetLabware:play_motion:NestApproach:retract".
 
-    Why the part (the step's phase): one motion plays different roles, and they take different
-    times: NestApproach from a bench to the hotel takes seconds, out of a pocket a fraction of one."""
+    Why the task and the part (the step's phase): one motion plays different roles, and they take
+    different times: NestApproach from a bench to the hotel takes seconds, out of a pocket a
+    fraction of one; the approach to a nest is short from the bench pose (GetLabware) and long
+    from the hotel (PutLabware)."""
     details = [str(step.goal[key]) for key in DETAIL_KEYS if key in step.goal]
     role = [step.phase.replace(" ", "_")] if step.phase else []
-    return ":".join([step.action, *details, *role])
+    return ":".join([*([task] if task else []), step.action, *details, *role])
 
 
 def table_from_parameters(parameters: Mapping[str, float]) -> dict[str, float]:
@@ -51,16 +53,16 @@ class StepDurations:
         self.table = dict(table)
         self.learned: dict[str, float] = {}
 
-    def estimate(self, step: Step) -> float:
-        kind = step_kind(step)
+    def estimate(self, step: Step, task: str = "") -> float:
+        kind = step_kind(step, task)
         seconds = self.learned.get(kind, self.table.get(kind, self.table.get(step.action, FALLBACK_S)))
         return max(float(seconds), 0.1)
 
-    def record(self, step: Step, seconds: float) -> None:
+    def record(self, step: Step, seconds: float, task: str = "") -> None:
         """A step of this kind ended successfully after `seconds` of robot time."""
         if seconds < 0:
             return  # the robot's clock started anew (a restarted robot side)
-        kind = step_kind(step)
-        log.info("%s took %.2f s (estimated %.2f s)", kind, seconds, self.estimate(step))
+        kind = step_kind(step, task)
+        log.info("%s took %.2f s (estimated %.2f s)", kind, seconds, self.estimate(step, task))
         before = self.learned.get(kind)
         self.learned[kind] = seconds if before is None else before + WEIGHT_OF_NEWEST * (seconds - before)

@@ -25,9 +25,10 @@ class TaskRun:
     """Progress bookkeeping of one task goal (lives on the executor thread)."""
 
     def __init__(
-        self, goal_handle: Any, feedback_type: type, plan: list[Step], durations: list[float]
+        self, goal_handle: Any, feedback_type: type, plan: list[Step], durations: list[float], task: str = ""
     ) -> None:
         self.goal_handle = goal_handle
+        self.task = task  # "GetLabware" or "PutLabware": step kinds are counted per task
         self.feedback_type = feedback_type
         self.durations = durations  # estimated robot seconds per step (step_durations)
         self.total = sum(self.durations)

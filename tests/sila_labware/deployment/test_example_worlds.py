@@ -11,6 +11,8 @@ from pathlib import Path
 
 import pytest
 
+from labware_model.holders import Nest
+from sila_labware.deployment.clients import transfer_client
 from sila_labware.deployment.demo import run_demo
 from tests.helpers.sila_stack import DEFAULT_WORLD, start_stack
 
@@ -22,7 +24,11 @@ EXPECTED = {
     "two_benches": ("plate_b", "bench_a/2", "bench_b/1"),
     "three_stations": ("dw_001", "sealer/1", "reader/2"),  # the deep-well plate
     "four_nests": ("plate_001", "reader/1", "plate_store/4"),  # the far end of the arm's band
+    "unusual_benches": ("plate_001", "low_bench/1", "high_bench/1"),  # the lowest and the highest bench
 }
+UNUSUAL = DEFAULT_WORLD.parent / "unusual_benches.yaml"
+# low_bench (0.60 m, heading 0) -> high_bench (0.78 m, 90) -> back_bench (180) -> corner_bench (-135)
+AROUND = (("low_bench", 1), ("high_bench", 1), ("back_bench", 2), ("corner_bench", 1))
 
 
 def test_every_example_world_has_a_transfer_here() -> None:
@@ -39,3 +45,19 @@ def test_an_example_world_delivers_the_demo_plate(tmp_path: Path, world: Path) -
     assert (report.labware_id, report.source, report.destination) == EXPECTED[world.stem]
     assert report.success, f"ground truth says the plate is not in its nest: {report}"
     assert report.plate_position_error_mm is not None and report.plate_position_error_mm < 5.0
+
+
+def test_one_plate_goes_round_benches_of_every_height_and_heading(tmp_path: Path) -> None:
+    """The unusual layouts of the random-layout issue in one lab: the lowest and highest bench top the
+    robot serves and bench headings 0, 90, 180 and -135 degrees; each leg is judged by physics."""
+    deployment = start_stack(tmp_path, insecure=True, world=UNUSUAL)
+    try:
+        assert deployment.link is not None
+        with transfer_client(deployment) as client:
+            for source, destination in zip(AROUND, AROUND[1:], strict=False):
+                client.transfer(source, destination, labware_id="plate_001")
+                placement = deployment.link.check_placement("plate_001", Nest(*destination), timeout_s=10.0)
+                assert placement.in_nest, f"{source} -> {destination}: {placement}"
+                assert 1000.0 * placement.position_error_m < 5.0
+    finally:
+        deployment.stop()

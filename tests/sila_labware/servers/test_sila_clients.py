@@ -9,6 +9,7 @@ plate must end physically in station_b's nest: judged from the simulation's grou
 from __future__ import annotations
 
 import asyncio
+import uuid
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Any
@@ -37,9 +38,14 @@ class ExecutionTrace:
     final_status: str = ""
 
 
+# Discovery by name finds every lab announced on this machine: a name of this run's own, so that a
+# `demo` or another test run beside it (the default lab's name) is never taken for ours.
+LAB = f"lab {uuid.uuid4().hex[:8]}"
+
+
 @pytest.fixture(scope="module")
 def stack(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Deployment]:
-    deployment = start_stack(tmp_path_factory.mktemp("unitelabs"), discovery=True)
+    deployment = start_stack(tmp_path_factory.mktemp("unitelabs"), discovery=True, lab_name=LAB)
     yield deployment
     deployment.stop()
 
@@ -247,11 +253,11 @@ def test_two_labs_on_one_network_are_told_apart_by_name(
     no CA file, reaches each lab's own robot."""
     from sila2.client import SilaClient
 
-    second = start_stack(tmp_path_factory.mktemp("second_lab"), discovery=True, lab_name="second lab")
+    second = start_stack(tmp_path_factory.mktemp("second_lab"), discovery=True, lab_name=f"second {LAB}")
     try:
         for lab, name in (
-            (stack, "TIAGo Labware Robot (default lab)"),
-            (second, "TIAGo Labware Robot (second lab)"),
+            (stack, f"TIAGo Labware Robot ({LAB})"),
+            (second, f"TIAGo Labware Robot (second {LAB})"),
         ):
             assert lab.robot_server().name == name
             client = SilaClient.discover(server_name=name, timeout=20)

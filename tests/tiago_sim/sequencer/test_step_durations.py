@@ -2,11 +2,16 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
-from tiago_sim.sequencer.plans import Step
+from tests.tiago_sim.sequencer.test_plans import WORKCELL, goal, robot, stations
+from tiago_sim.sequencer.node import load_params
+from tiago_sim.sequencer.plans import Step, get_plan, put_plan
 from tiago_sim.sequencer.step_durations import FALLBACK_S, StepDurations, step_kind, table_from_parameters
 
+SEQUENCER_YAML = Path(__file__).resolve().parents[3] / "tiago_sim" / "sequencer" / "sequencer.yaml"
 APPROACH = Step("marker_motion", {"station": "a", "sub_position": 1, "target": "work_pose"})
 TOOL_MOVE = Step("marker_motion", {"station": "a", "sub_position": 1, "target": "site"})
 
@@ -22,6 +27,36 @@ def test_a_step_kind_names_the_action_and_what_it_does() -> None:
         "play_motion:NestApproach:to_hotel",
         "play_motion:NestApproach:retract",
     )
+
+
+def test_a_kind_is_counted_per_task() -> None:
+    """The approach to a nest: short from the bench pose (GetLabware), long from the hotel (PutLabware)."""
+    approach = Step(
+        "marker_motion", {"station": "a", "sub_position": 1, "target": "site_approach"}, "approach"
+    )
+    assert step_kind(approach, "PutLabware") == "PutLabware:marker_motion:site_approach:approach"
+    durations = StepDurations(table_from_parameters({"PutLabware.marker_motion.site_approach.approach": 3.3}))
+    assert (durations.estimate(approach, "PutLabware"), durations.estimate(approach, "GetLabware")) == (
+        3.3,
+        3.0,
+    )
+    durations.record(approach, 1.0, "GetLabware")
+    assert (durations.estimate(approach, "PutLabware"), durations.estimate(approach, "GetLabware")) == (
+        3.3,
+        1.0,
+    )
+
+
+def test_the_shipped_table_names_every_step_of_both_plans_at_a_station() -> None:
+    """sequencer.yaml: no step of a task that starts at its station falls back to its action's row."""
+    table = table_from_parameters(load_params(SEQUENCER_YAML)["estimates_s"])
+    plans = (
+        ("GetLabware", get_plan(goal(), WORKCELL, robot(), stations("P1"), "right")),
+        ("PutLabware", put_plan(goal(), WORKCELL, robot({1: "P1", 2: ""}), stations(), "right")),
+    )
+    for task, plan in plans:
+        missing = [step_kind(step, task) for step in plan if step_kind(step, task) not in table]
+        assert missing == [], missing
 
 
 def test_the_table_names_kinds_where_it_can_and_actions_for_the_rest() -> None:
