@@ -2,12 +2,16 @@
 
 Why: the sim node and the sequencer start, spin and stop the same way (signals set a flag so a
 stopped node exits quietly instead of raising ExternalShutdownException mid-callback); one copy
-keeps their shutdown order alike. Lives on: the process's main thread.
+keeps their shutdown order alike. A node also stops once the process that started it is gone (it
+was re-parented): a deployment killed without its clean-up (SIGKILL, or SIGTERM to a script that
+does not handle it) left its robot side running, still in its ROS domain, and the next run that
+reserved that domain met two robots answering one action. Lives on: the process's main thread.
 """
 
 from __future__ import annotations
 
 import logging
+import os
 import signal
 from collections.abc import Callable
 from typing import Any
@@ -45,12 +49,16 @@ def spin_node(
 
     signal.signal(signal.SIGINT, request_stop)
     signal.signal(signal.SIGTERM, request_stop)
+    parent = os.getppid()
     owner = None
     try:
         owner = build(node)
         executor.add_node(node)
         while not stopping and rclpy.ok():
             executor.spin_once(timeout_sec=0.1)
+            if os.getppid() != parent:
+                log.warning("the process that started this node (pid %d) is gone: shutting down", parent)
+                break
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
