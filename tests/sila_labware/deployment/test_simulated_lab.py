@@ -107,6 +107,36 @@ def test_a_path_closed_mid_drive_fails_the_drive_with_navigation_failed(cell: Ce
     reset(cell)
 
 
+def test_an_occluded_marker_fails_the_pick_and_clearing_the_fault_lets_it_run(cell: Cell) -> None:
+    lab = lab_controls(cell)
+    lab.InjectFault(Fault="OccludeMarker", Target="station_a")
+    assert lab.ActiveFaults.get() == ["OccludeMarker station_a"]
+    cell.prepare_pick(A1, PLATE)
+    with pytest.raises(DefinedExecutionError, match="MARKER_NOT_FOUND"):
+        cell.pick(A1)
+    assert cell.deployment.link.check_placement(PLATE, Nest(*A1)).in_nest, "the plate was not touched"
+    lab.ClearFaults()
+    assert lab.ActiveFaults.get() == []
+    reset(cell)
+    cell.transfer(A1, B1, PLATE)  # the marker is in view again
+    assert cell.deployment.link.check_placement(PLATE, Nest(*B1)).in_nest
+    reset(cell)
+
+
+def test_a_plate_dropped_from_the_hotel_on_the_way_fails_the_put_and_is_not_claimed(cell: Cell) -> None:
+    lab = lab_controls(cell)
+    cell.prepare_pick(A1, PLATE)
+    cell.pick(A1)
+    lab.InjectFault(Fault="DropPlate", Target=PLATE)  # slips out of the hotel on the next drive
+    with pytest.raises(DefinedExecutionError, match="PLATE_SLIPPED|SLOT_EMPTY"):
+        cell.place(B1, PLATE)
+    assert not cell.deployment.link.check_placement(PLATE, Nest(*B1)).in_nest
+    with pytest.raises(DefinedExecutionError, match="UnknownLabware.*lost"):  # not claimed delivered
+        cell.location(PLATE)
+    reset(cell)
+    assert cell.deployment.link.check_placement(PLATE, Nest(*A1)).in_nest
+
+
 @pytest.mark.parametrize(
     ("fault", "target", "named"),
     [
