@@ -62,6 +62,8 @@ def main(argv: list[str] | None = None) -> int:
             "demo_success": bool(verdict.get("success")),
             "total_s": round(venv_s + install_s + demo_s, 1),
         }
+        if not figures["demo_success"]:  # the venv goes with the scratch folder: keep what the demo said
+            figures["demo_error"] = verdict.get("error") or demo.stderr.strip()[-2000:]
         print(json.dumps(figures))
         return 0 if figures["demo_success"] else 1
 
