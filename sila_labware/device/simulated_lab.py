@@ -77,6 +77,7 @@ class SimulatedLab:
         self.robot = robot
         self.stations = tuple(stations)
         self.pace = pace or 0.0
+        robot.pace.set_nominal(self.pace)
         self._faults: list[str] = []
         self._lock = threading.Lock()
 
@@ -137,6 +138,7 @@ class SimulatedLab:
             )
         )
         self.pace = pace
+        self.robot.pace.set_nominal(pace)
 
     def _set_fault(self, fault: str, target: str) -> None:
         try:

@@ -37,6 +37,25 @@ def test_the_pace_is_robot_time_over_wall_time_in_the_last_window() -> None:
     assert pace.factor == pytest.approx(1.0)
 
 
+def test_a_set_pace_is_the_factor_while_the_measurement_agrees_and_not_when_it_does_not() -> None:
+    wall = WallClock()
+    pace = RobotPace(window_s=2.0, wall_clock=wall)
+    pace.set_nominal(1.0)
+    assert pace.factor == 1.0
+    for step, arrival_jitter in enumerate(
+        (0.0, 0.06, -0.05, 0.04, 0.0)
+    ):  # state reports arrive late or early
+        wall.now = 100.0 + 0.25 * step + arrival_jitter
+        pace.observe(status(0.25 * step))
+    assert pace.factor == 1.0, "jitter of a few reports does not move a remaining time off the set pace"
+    for step in range(5, 15):  # a machine too slow for the set pace: the robot's clock runs at 0.5
+        wall.now = 100.0 + 0.25 * step
+        pace.observe(status(1.0 + 0.125 * (step - 4)))
+    assert pace.factor == pytest.approx(0.5)
+    pace.set_nominal(None)  # as fast as the machine allows: the measurement only
+    assert pace.factor == pytest.approx(0.5)
+
+
 def test_a_restarted_robot_clock_starts_the_measurement_anew() -> None:
     wall = WallClock()
     pace = RobotPace(wall_clock=wall)
