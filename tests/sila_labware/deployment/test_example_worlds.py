@@ -28,7 +28,14 @@ EXPECTED = {
 }
 UNUSUAL = DEFAULT_WORLD.parent / "unusual_benches.yaml"
 # low_bench (0.60 m, heading 0) -> high_bench (0.78 m, 90) -> back_bench (180) -> corner_bench (-135)
-AROUND = (("low_bench", 1), ("high_bench", 1), ("back_bench", 2), ("corner_bench", 1))
+# -> side_marker_bench (-90, its marker far right of the working pose)
+AROUND = (
+    ("low_bench", 1),
+    ("high_bench", 1),
+    ("back_bench", 2),
+    ("corner_bench", 1),
+    ("side_marker_bench", 1),
+)
 
 
 def test_every_example_world_has_a_transfer_here() -> None:
@@ -49,7 +56,8 @@ def test_an_example_world_delivers_the_demo_plate(tmp_path: Path, world: Path) -
 
 def test_one_plate_goes_round_benches_of_every_height_and_heading(tmp_path: Path) -> None:
     """The unusual layouts of the random-layout issue in one lab: the lowest and highest bench top the
-    robot serves and bench headings 0, 90, 180 and -135 degrees; each leg is judged by physics."""
+    robot serves, bench headings 0, 90, 180, -135 and -90 degrees and a marker far right of the
+    working pose; each leg is judged by physics."""
     deployment = start_stack(tmp_path, insecure=True, world=UNUSUAL)
     try:
         assert deployment.link is not None
