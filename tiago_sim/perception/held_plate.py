@@ -7,8 +7,8 @@ millimetres at every station, mostly sideways), the arm's joint offsets shift th
 pick and a place those errors would cancel if the plate kept the offset it was grasped with, but it
 does not: the fingers centre its short side at the pick, and the onboard hotel's pocket (2 mm of
 clearance) re-centres it in the base frame, after which the hand holds it a few millimetres off in
-an unknown way (measured in replays: the plate 8 to 11 mm off the nest, 7 of them the marker's
-error in the robot's frame, on the 7.5 mm the nest's ramps capture). Seen in the same image as the
+a way unrelated to the nest (replays of default-lab seed 60000: the nest believed 7 mm off, the
+plate released 9.4 mm off it, past the 7.5 mm its ramps capture). Seen in the same image as the
 marker - the head unmoved since the marker was sighted, so the camera's error is the same - plate
 and nest share the camera's error and their difference is free of it and of the arm's: what is
 left is the marker's and the nest's own mounting on the station, and the depth noise.
