@@ -101,7 +101,7 @@ def locate_held_plate(
     inner = near & (np.abs(points[:, 1] - tool_y) < width / 2 - 0.008)
     searched = inner & (np.abs(points[:, 2] - nominal_top) < TOP_SEARCH_M)
     if searched.sum() < MIN_POINTS:
-        log.info("held plate: %d pixels near its top's height, too few", int(searched.sum()))
+        log.debug("held plate: %d pixels near its top's height, too few", int(searched.sum()))
         return None
     top = float(np.median(points[searched, 2]))
     on_top = near & (np.abs(points[:, 2] - top) < TOP_BAND_M)
@@ -111,7 +111,7 @@ def locate_held_plate(
     within_ends = (points[:, 0] > x_low + 0.004) & (points[:, 0] < x_high - 0.004)
     across = points[beyond_pads & within_ends]
     if len(along) < MIN_POINTS or len(across) < MIN_POINTS:
-        log.info("held plate: %d pixels along, %d across, too few", len(along), len(across))
+        log.debug("held plate: %d pixels along, %d across, too few", len(along), len(across))
         return None
     y_low, y_high = _extent(across[:, 1])
     # percentile extents fall short of the edges by about that share of the side on each end
@@ -124,7 +124,7 @@ def locate_held_plate(
         len(along),
     )
     if abs(sighting.length - length) > EXTENT_TOLERANCE_M or abs(sighting.width - width) > EXTENT_TOLERANCE_M:
-        log.info(
+        log.debug(
             "held plate: measured %.1f x %.1f mm, the plate is %.1f x %.1f mm: no measurement",
             1000 * sighting.length, 1000 * sighting.width, 1000 * length, 1000 * width,
         )  # fmt: skip

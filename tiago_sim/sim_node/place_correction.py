@@ -78,6 +78,7 @@ def place_shift(
         if sighting is not None:
             break
     if sighting is None:
+        log.info("held plate not measured: no plate type fits the pixels about the tool (an end hidden?)")
         return None
     shift = np.array([tool[0] - sighting.x, tool[1] - sighting.y])
     log.info(
