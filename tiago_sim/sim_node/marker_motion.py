@@ -22,7 +22,7 @@ from __future__ import annotations
 import logging
 import math
 import threading
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -37,6 +37,7 @@ from tiago_sim.robot.motion_library import HotelGrasp
 from tiago_sim.sim_node.action_run import ActionAbort, ActionRun
 from tiago_sim.sim_node.base_alignment import align_base
 from tiago_sim.sim_node.behaviours import TOOL_SPEED_FREE, TOOL_SPEED_INTO_POCKET, RobotBehaviours
+from tiago_sim.sim_node.place_correction import place_shift
 
 log = logging.getLogger(__name__)
 
@@ -53,6 +54,7 @@ class MarkerSighting:
     T_base_marker: np.ndarray
     odometry: tuple[float, float, float]
     reprojection_error_px: float
+    joints: dict[str, float] = field(default_factory=dict)  # readings taken with the image
 
 
 def pose_msg(transform: np.ndarray) -> Pose:
@@ -94,6 +96,7 @@ class MarkerMotionBehaviour:
             T_base_optical @ observation.T_optical_marker,
             odometry,
             observation.reprojection_error_px,
+            joints,
         )
         log.info(
             "marker %d of %s at %s in base, quaternion %s (reprojection %.2f px)",
@@ -111,6 +114,34 @@ class MarkerMotionBehaviour:
         moved = math.hypot(x - sighting.odometry[0], y - sighting.odometry[1])
         turned = abs(math.remainder(yaw - sighting.odometry[2], math.tau))
         return sighting if moved < SAME_BASE_POSITION_M and turned < SAME_BASE_YAW_RAD else None
+
+    def _centred_on_plate(
+        self, run: ActionRun, arm: str, T_base_site: np.ndarray, sighting: MarkerSighting
+    ) -> np.ndarray:
+        """The site moved by the shift that centres the held plate on it (as it is without a
+        measurement). Taken from where the tool stands now, above the nest after the approach."""
+
+        def capture(sim: Any) -> tuple:
+            _rgb, depth, intrinsics = sim.render_head_camera()
+            return depth, intrinsics, dict(sim.joint_positions())
+
+        def forward(joints: dict[str, float], frame: str) -> np.ndarray:
+            with self._lock:
+                return self.kinematics.forward(joints, frame)
+
+        shift = place_shift(
+            lambda: run.sim(capture),
+            forward,
+            T_base_site,
+            arm,
+            CAMERA_FRAME,
+            sighting.joints,
+            self.world.labware_types.values(),
+            self.grasp.grasp_height_m,
+        )
+        if shift is None:
+            return T_base_site
+        return T_base_site @ tf.make_transform((float(shift[0]), float(shift[1]), 0.0))
 
     def __call__(self, run: ActionRun, goal: Any) -> dict:
         arm = self.behaviours.arm_of(goal.arm)
@@ -154,6 +185,8 @@ class MarkerMotionBehaviour:
         # fingers"). Heading and position still come from the marker.
         T_base_site = tf.levelled(sighting.T_base_marker @ T_marker_site)
         releasing = goal.target == "site" and self.behaviours.holding.get(arm, False)
+        if releasing:  # where the plate hangs, seen with the nest's marker: shift the tool to centre it
+            T_base_site = self._centred_on_plate(run, arm, T_base_site, sighting)
         T_base_grasp = T_base_site @ self.grasp.T_slot_grasp(approach=False, releasing=releasing)
         T_base_target = self.behaviours.grasp_twin(arm, T_base_grasp, seed)
         in_nest = goal.target == "site"  # slow only where the plate enters or leaves the nest
