@@ -29,7 +29,13 @@ from labware_model.labware import LabwareType, Plate
 from labware_model.workcell import StationDescription, WorkcellDescription
 from tiago_sim import transforms as tf
 from tiago_sim.lab import world_schema as schema
-from tiago_sim.lab.world_obstacles import Bench, Obstacle, dock_path_points, placement_problems
+from tiago_sim.lab.world_obstacles import (
+    Bench,
+    Obstacle,
+    bench_overlap_problems,
+    dock_path_points,
+    placement_problems,
+)
 from tiago_sim.lab.world_rules import check
 from tiago_sim.lab.world_schema import MARKER_DICTIONARY_SIZE, MIRROR_AMBIGUOUS_MARKER_IDS
 
@@ -197,7 +203,7 @@ def world_from_raw(raw: Any, source: str, default_name: str = "lab", *, check_ro
     if model is None:
         raise WorldError([problem.line(source) for problem in problems])
     world = _world(model, source, default_name=default_name)
-    placement = _obstacle_placement_problems(world)
+    placement = _bench_placement_problems(world) + _obstacle_placement_problems(world)
     if placement:
         raise WorldError([f"{source}: {where}: {what}" for where, what in placement])
     if check_robot:
@@ -207,6 +213,18 @@ def world_from_raw(raw: Any, source: str, default_name: str = "lab", *, check_ro
         if refused:
             raise WorldError([f"{source}: {problem.where}: {problem.what}" for problem in refused])
     return world
+
+
+def _benches(world: World) -> list[Bench]:
+    return [
+        Bench(s.name, s.table_pose.x, s.table_pose.y, s.table_pose.yaw, s.table_size[0], s.table_size[1])
+        for s in world.stations
+    ]
+
+
+def _bench_placement_problems(world: World) -> list[tuple[str, str]]:
+    """No two benches in the same place (`world_obstacles.bench_overlap_problems`)."""
+    return [(f"stations[{j}].table.pose", what) for j, what in bench_overlap_problems(_benches(world))]
 
 
 def _obstacle_placement_problems(world: World) -> list[tuple[str, str]]:
@@ -220,11 +238,7 @@ def _obstacle_placement_problems(world: World) -> list[tuple[str, str]]:
     for station in world.stations:
         aligned = station.aligned_pose()
         keep_clear[f"{station.name}'s working pose"] = (aligned.x, aligned.y)
-    benches = [
-        Bench(s.name, s.table_pose.x, s.table_pose.y, s.table_pose.yaw, s.table_size[0], s.table_size[1])
-        for s in world.stations
-    ]
-    return placement_problems(world.obstacles, world.floor_size, benches, keep_clear)
+    return placement_problems(world.obstacles, world.floor_size, _benches(world), keep_clear)
 
 
 def _obstacle(item: schema.Obstacle) -> Obstacle:

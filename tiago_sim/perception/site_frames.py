@@ -69,3 +69,20 @@ def levelled(T_base_frame: np.ndarray) -> np.ndarray:
     z_axis = np.array([0.0, 0.0, 1.0])
     rotation = np.column_stack([x_axis, np.cross(z_axis, x_axis), z_axis])
     return make_transform(transform[:3, 3], rotation)
+
+
+def upright_marker(T_base_marker: np.ndarray, T_table_marker: np.ndarray) -> np.ndarray:
+    """The observed marker pose with its tilt taken from the station's level bench, not from the image.
+
+    Keeps the observed position and the bench's observed heading; the marker's roll and pitch about
+    the floor are the world file's (``T_table_marker`` on a level table top). Why: a nest lies 0.1 to
+    0.15 m from its marker, so the marker's orientation error moves the nest by that lever. Position
+    is what a single marker measures best; its out-of-plane tilt and its in-plane turn are what it
+    measures worst, and the in-plane turn is partly a marker glued askew, which the nests do not
+    share. Seen tilted by 1.1 deg, the marker put a nest 7.5 mm too low (random layout 91028: a finger
+    pad pressed on the bench top); upright, 1.9 mm.
+    """
+    T_base_table = levelled(np.asarray(T_base_marker, dtype=float) @ np.linalg.inv(T_table_marker))
+    upright = np.asarray(T_base_marker, dtype=float).copy()
+    upright[:3, :3] = T_base_table[:3, :3] @ np.asarray(T_table_marker, dtype=float)[:3, :3]
+    return upright

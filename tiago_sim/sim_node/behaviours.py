@@ -143,9 +143,13 @@ class RobotBehaviours:
                 ErrorCodes.BAD_GOAL, f"unknown motion {name!r}: known are {', '.join(self.motions.names())}"
             )
         frames = self.motions.frames_for(name, arm)
-        first = 0.0
-        if name not in ("Home", "Tuck"):
-            first = self.leave_hotel(run, arm)  # never sweep a held plate through the hotel
+        # Every fixed motion leaves the hotel straight up to the carry height first: a held plate is
+        # never swept through the hotel, and an empty gripper folding from the hotel's approach pose
+        # (0.71 m high) swings its pads up to 0.40 m ahead of the base at 0.77 m, where a bench's front
+        # edge (0.36 .. 0.45 m ahead at a working pose, top up to 0.78 m) stands: random layout 91089,
+        # Tuck after GetLabware grazed the incubator's edge 1.5 mm deep. From the carry height the fold
+        # stays above 0.85 m (tests/tiago_sim/robot/test_fold_sweep.py).
+        first = self.leave_hotel(run, arm)
         speed = self.speed_scale() * self.motions.speed_scale
         for index, targets in enumerate(frames):
             span = (

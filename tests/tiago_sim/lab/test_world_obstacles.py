@@ -10,6 +10,7 @@ import pytest
 
 from tests.tiago_sim.lab.test_world_schema import Mutation, problems_of
 from tiago_sim.lab.world import DEFAULT_WORLD, load_world
+from tiago_sim.lab.world_obstacles import Bench, bench_overlap_problems
 
 BENCH_IN_THE_WAY = DEFAULT_WORLD.parent / "bench_in_the_way.yaml"
 
@@ -91,3 +92,25 @@ def test_bench_in_the_way_loads_its_obstacle_in_radians() -> None:
     assert bench.name == "bench_c" and (bench.length, bench.width, bench.height) == (0.6, 1.0, 0.75)
     assert bench.yaw == pytest.approx(math.radians(142.0))
     assert not bench.is_cylinder
+
+
+def test_overlapping_benches_are_refused(tmp_path: Path) -> None:
+    """A bench standing in another (random layouts 91027 and 91033 drew such): the higher top covered
+    the other's nest."""
+
+    def overlap(d: dict[str, Any]) -> None:
+        d["stations"][1]["table"]["pose"] = [2.3, 0.3, 30.0]
+
+    assert problems_of(tmp_path, overlap) == [
+        "stations[1].table.pose: station_b's bench overlaps station_a's bench"
+    ]
+
+
+def test_benches_side_by_side_are_accepted() -> None:
+    benches = [Bench("a", 0.0, 0.0, 0.0, 0.6, 1.0), Bench("b", 0.6, 0.0, 0.0, 0.6, 1.0)]
+    assert bench_overlap_problems(benches) == []
+    benches.append(Bench("c", 0.3, 0.45, math.radians(90.0), 0.6, 0.4))
+    assert bench_overlap_problems(benches) == [
+        (2, "c's bench overlaps a's bench"),
+        (2, "c's bench overlaps b's bench"),
+    ]

@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from tiago_sim.perception.aruco import detect_marker
 from tiago_sim.perception.camera import CameraIntrinsics, optical_frame_looking_at, render_rgbd
 from tiago_sim.perception.marker_asset import marker_visual
-from tiago_sim.perception.site_frames import levelled, site_frames
+from tiago_sim.perception.site_frames import levelled, site_frames, upright_marker
 from tiago_sim.transforms import from_xyz_rpy, invert, rotation_angle, yaw_of
 
 angles = st.floats(-np.pi, np.pi, allow_nan=False)
@@ -87,3 +87,40 @@ def test_site_from_rendered_marker_matches_the_placed_site(tmp_path: Path) -> No
     assert np.degrees(rotation_angle(frames.T_base_site[:3, :3], T_base_site_true[:3, :3])) <= 1.0
     np.testing.assert_allclose(T_base_site_true[:3, 2], [0.0, 0.0, 1.0], atol=1e-9)
     assert frames.T_base_site_approach[2, 3] == pytest.approx(frames.T_base_site[2, 3] + 0.08, abs=0.002)
+
+
+MARKER_UPRIGHT = from_xyz_rpy((-0.1, 0.0, 0.09), np.radians((90.0, 0.0, -90.0)))  # x right, y up, z out
+SITE_IN_MARKER = from_xyz_rpy((-0.08, -0.1, 0.12), np.radians((-90.0, 0.0, 0.0)))  # 0.1 m below, 0.12 m out
+
+
+@settings(max_examples=40, deadline=None)
+@given(bench_yaw=angles, tilt_deg=st.floats(-2.0, 2.0), turn_deg=st.floats(-2.0, 2.0))
+def test_an_upright_marker_puts_the_nest_where_it_is_whatever_tilt_the_image_shows(
+    bench_yaw, tilt_deg, turn_deg
+):
+    """A marker seen tilted about its horizontal axis and turned in its own plane: the raw pose moves
+    the nest by the lever (random layout 91028: 7.5 mm too low); the upright one keeps it in place."""
+    T_base_marker = from_xyz_rpy((0.9, -0.2, 0.75), (0.0, 0.0, bench_yaw)) @ MARKER_UPRIGHT
+    seen = T_base_marker @ from_xyz_rpy((0.0, 0.0, 0.0), np.radians((tilt_deg, 0.0, turn_deg)))
+    site, true_site = upright_marker(seen, MARKER_UPRIGHT) @ SITE_IN_MARKER, T_base_marker @ SITE_IN_MARKER
+    # both turns together also turn the heading, by their product (2 deg x 2 deg: 0.07 deg, 0.15 mm)
+    assert np.linalg.norm(site[:3, 3] - true_site[:3, 3]) < 0.0002
+    assert np.degrees(rotation_angle(site[:3, :3], true_site[:3, :3])) < 0.08
+
+
+@settings(max_examples=40, deadline=None)
+@given(bench_yaw=angles, heading_deg=st.floats(-3.0, 3.0))
+def test_an_upright_marker_keeps_the_heading_the_image_shows(bench_yaw, heading_deg):
+    """A turn about the vertical is the bench's heading, which only the image tells: kept."""
+    T_base_marker = from_xyz_rpy((0.9, -0.2, 0.75), (0.0, 0.0, bench_yaw)) @ MARKER_UPRIGHT
+    seen = T_base_marker @ from_xyz_rpy((0.0, 0.0, 0.0), np.radians((0.0, heading_deg, 0.0)))
+    assert np.allclose(upright_marker(seen, MARKER_UPRIGHT), seen, atol=1e-9)
+
+
+def test_the_raw_marker_tilt_moves_the_nest_by_its_lever():
+    seen = MARKER_UPRIGHT @ from_xyz_rpy((0.0, 0.0, 0.0), np.radians((1.1, 0.0, 0.0)))
+    true_height = (MARKER_UPRIGHT @ SITE_IN_MARKER)[2, 3]
+    assert abs((seen @ SITE_IN_MARKER)[2, 3] - true_height) > 0.002
+    assert (upright_marker(seen, MARKER_UPRIGHT) @ SITE_IN_MARKER)[2, 3] == pytest.approx(
+        true_height, abs=1e-9
+    )
