@@ -30,7 +30,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from tiago_sim.perception.camera import CameraIntrinsics
-from tiago_sim.robot.robot_model import PAD_WIDTH
 
 log = logging.getLogger(__name__)
 
@@ -85,13 +84,15 @@ def locate_held_plate(
     length: float,
     width: float,
     height: float,
+    pad_width: float,
 ) -> HeldPlateSighting | None:
     """The plate held by a tool at ``tool_in_site`` (grasping frame origin, site frame), or None.
 
     ``points``: depth pixels in the site frame (``site_points``); ``plate_bottom_below_tool``: how
     far below the grasping frame the plate's bottom is expected (the grasp height); ``length``,
-    ``width``, ``height``: the plate type's outer size. Percentile extents trim the same share at
-    both ends, so the centre stays unbiased while a stray pixel cannot move it.
+    ``width``, ``height``: the plate type's outer size; ``pad_width``: the finger pads' width along
+    the plate's long side (the robot model's), which hides the top face there. Percentile extents
+    trim the same share at both ends, so the centre stays unbiased while a stray pixel cannot move it.
     """
     tool_x, tool_y, tool_z = (float(v) for v in tool_in_site[:3])
     nominal_top = tool_z - plate_bottom_below_tool + height
@@ -107,7 +108,7 @@ def locate_held_plate(
     on_top = near & (np.abs(points[:, 2] - top) < TOP_BAND_M)
     along = points[on_top & inner]
     x_low, x_high = _extent(along[:, 0])
-    beyond_pads = on_top & (np.abs(points[:, 0] - tool_x) > PAD_WIDTH / 2 + BEYOND_PADS_M)
+    beyond_pads = on_top & (np.abs(points[:, 0] - tool_x) > pad_width / 2 + BEYOND_PADS_M)
     within_ends = (points[:, 0] > x_low + 0.004) & (points[:, 0] < x_high - 0.004)
     across = points[beyond_pads & within_ends]
     if len(along) < MIN_POINTS or len(across) < MIN_POINTS:

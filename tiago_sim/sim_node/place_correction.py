@@ -25,6 +25,7 @@ import numpy as np
 from labware_model.labware import LabwareType
 from tiago_sim import transforms as tf
 from tiago_sim.perception.held_plate import HeldPlateSighting, locate_held_plate, site_points
+from tiago_sim.robot.robot_model import PAD_WIDTH
 
 log = logging.getLogger(__name__)
 
@@ -73,7 +74,7 @@ def place_shift(
     sighting: HeldPlateSighting | None = None
     for plate in plate_types:
         sighting = locate_held_plate(
-            points, tool, plate_bottom_below_tool, plate.length, plate.width, plate.height
+            points, tool, plate_bottom_below_tool, plate.length, plate.width, plate.height, PAD_WIDTH
         )
         if sighting is not None:
             break

@@ -16,6 +16,7 @@ from labware_model.labware import LabwareType
 from tiago_sim import transforms as tf
 from tiago_sim.perception.camera import CameraIntrinsics, optical_frame_looking_at, render_rgbd
 from tiago_sim.perception.held_plate import locate_held_plate, site_points
+from tiago_sim.robot.robot_model import PAD_WIDTH
 from tiago_sim.sim_node.place_correction import place_shift
 
 PLATE = LabwareType("sbs", 0.12776, 0.08548, 0.01435, 0.35)
@@ -67,7 +68,9 @@ def test_the_plate_centre_is_found_within_a_millimetre(plate_xy):
     depth, T_world_optical = _render(plate_xy, tool_xy)
     points = site_points(depth, CameraIntrinsics(), tf.invert(T_WORLD_SITE) @ T_world_optical)
     tool = np.array([*tool_xy, APPROACH + GRASP_HEIGHT])
-    sighting = locate_held_plate(points, tool, GRASP_HEIGHT, PLATE.length, PLATE.width, PLATE.height)
+    sighting = locate_held_plate(
+        points, tool, GRASP_HEIGHT, PLATE.length, PLATE.width, PLATE.height, PAD_WIDTH
+    )
     assert sighting is not None
     assert abs(sighting.x - plate_xy[0]) < 0.001
     assert abs(sighting.y - plate_xy[1]) < 0.001
@@ -77,7 +80,10 @@ def test_a_plate_with_an_end_hidden_gives_no_measurement():
     depth, T_world_optical = _render((0.004, 0.0), (0.0, 0.0), hide_left_end=True)
     points = site_points(depth, CameraIntrinsics(), tf.invert(T_WORLD_SITE) @ T_world_optical)
     tool = np.array([0.0, 0.0, APPROACH + GRASP_HEIGHT])
-    assert locate_held_plate(points, tool, GRASP_HEIGHT, PLATE.length, PLATE.width, PLATE.height) is None
+    assert (
+        locate_held_plate(points, tool, GRASP_HEIGHT, PLATE.length, PLATE.width, PLATE.height, PAD_WIDTH)
+        is None
+    )
 
 
 def test_the_place_shift_is_free_of_the_camera_calibration_error():
