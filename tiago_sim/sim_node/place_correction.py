@@ -31,8 +31,11 @@ log = logging.getLogger(__name__)
 
 HEAD_JOINTS = ("head_1_joint", "head_2_joint")
 # The head counts as unmoved since the marker sighting within this (rad): the camera's error is then the
-# same in both images (0.1 deg of a head joint is 1 mm at the nest).
-SAME_HEAD_RAD = 0.0005
+# same in both images. That error (mount offset, encoder zeros) is constant; turning the head by
+# 0.01 rad turns the few millimetres it makes at the nest by as much, a change of hundredths of a
+# millimetre. A head still settling from its last aim moved 1 to 3 mrad between the two images,
+# and 0.5 mrad skipped the measurement then (default-lab seeds 96000, 96015 at 591b7bc).
+SAME_HEAD_RAD = 0.01
 # A larger shift is not believed: the measurement would have gone wrong (the nest's ramps capture
 # 7.5 mm, calibration and mounting errors reach about 12 mm together at three sigma).
 MAX_SHIFT_M = 0.015
@@ -66,7 +69,8 @@ def place_shift(
     """
     depth, intrinsics, joints = capture()
     if head_moved(sighting_joints, joints):
-        log.info("held plate not measured: the head moved since the marker was seen")
+        turned = {n: round(joints.get(n, 0.0) - sighting_joints.get(n, 0.0), 4) for n in HEAD_JOINTS}
+        log.info("held plate not measured: the head moved since the marker was seen (%s rad)", turned)
         return None
     T_site_base = tf.invert(T_base_site)
     points = site_points(depth, intrinsics, T_site_base @ forward(joints, camera_frame))

@@ -116,16 +116,23 @@ def test_the_place_shift_is_free_of_the_camera_calibration_error():
     np.testing.assert_allclose(plate_in_site[:2, 3], [0.0, 0.0], atol=0.001)
 
 
-def test_no_shift_once_the_head_has_turned():
+@pytest.mark.parametrize(
+    ("pan_then", "measured"),
+    [(0.1 + 0.05, False), (0.1 + 0.003, True)],  # re-aimed; still settling from the last aim (96000)
+    ids=["turned", "settling"],
+)
+def test_no_shift_once_the_head_has_turned_but_one_while_it_settles(pan_then: float, measured: bool):
     depth, T_world_optical = _render((0.0, 0.0), (0.0, 0.0))
+    T_world_tool = T_WORLD_SITE @ tf.make_transform((0.0, 0.0, APPROACH + GRASP_HEIGHT))
+    frames = {"head_camera_optical_frame": T_world_optical, "arm_right_grasping_frame": T_world_tool}
     shift = place_shift(
         lambda: (depth, CameraIntrinsics(), {"head_1_joint": 0.1, "head_2_joint": -0.9}),
-        lambda _joints, _frame: np.eye(4),
+        lambda _joints, frame: frames[frame],
         T_WORLD_SITE,
         "right",
         "head_camera_optical_frame",
-        {"head_1_joint": 0.1 + 0.01, "head_2_joint": -0.9},
+        {"head_1_joint": pan_then, "head_2_joint": -0.9},
         [PLATE],
         GRASP_HEIGHT,
     )
-    assert shift is None
+    assert (shift is not None) == measured
