@@ -218,8 +218,7 @@ class Sequencer:
             self.step_durations.table = table_from_parameters(
                 {key: float(self.param(f"estimates_s.{key}")) for key in self.estimate_keys}
             )
-            durations = [self.step_durations.estimate(step, kind.__name__) for step in plan]
-            run = TaskRun(goal_handle, kind.Feedback, plan, durations, kind.__name__)
+            run = TaskRun.for_plan(goal_handle, kind, plan, self.step_durations, self._robot_seconds)
             self.active = run
             try:
                 run.publish()

@@ -58,6 +58,11 @@ class StepDurations:
         seconds = self.learned.get(kind, self.table.get(kind, self.table.get(step.action, FALLBACK_S)))
         return max(float(seconds), 0.1)
 
+    def measured(self, step: Step, task: str = "") -> bool:
+        """Whether the estimate of this kind was measured (a row of the table, or what it took)."""
+        kind = step_kind(step, task)
+        return kind in self.learned or kind in self.table
+
     def record(self, step: Step, seconds: float, task: str = "") -> None:
         """A step of this kind ended successfully after `seconds` of robot time."""
         if seconds < 0:
