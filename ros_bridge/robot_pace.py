@@ -6,10 +6,10 @@ robot's clock is the wall clock). A SiLA client counts wall seconds, so a remain
 divided by the pace before it is reported. The pace is measured over the last few state reports
 (their stamps against the wall time they arrived at), so it follows a change of pace within a
 window; until two reports span a measurable time it is 1. Where the robot's clock is told to run at
-a set pace (`set_nominal`: a paced simulation), that pace is the factor as long as the measurement
-agrees with it within `NOMINAL_TOLERANCE`: the arrival times of a few state reports jitter by tens
-of milliseconds on a loaded machine, which moved a reported remaining time by 10 to 20 % at pace 1;
-a measurement far off the set pace (a machine too slow for it) still wins.
+a set pace (`set_nominal`: a paced simulation), that pace is the factor unless the measurement falls
+below `TOO_SLOW` of it: the robot's clock is capped at the set pace, so a faster reading is the
+arrival jitter of a few state reports on a loaded machine (it moved a reported remaining time by
+20 to 40 % at pace 1), and only a reading far below says the machine cannot keep the pace.
 
 Threads: `observe` is called on the ROS thread (a state listener), `to_wall_s` on any thread;
 one lock guards the samples.
@@ -26,7 +26,7 @@ from ros_bridge.workcell import RobotStatus
 
 WINDOW_S = 2.0  # s of wall time the pace is measured over (/robot_state comes at 2 Hz or faster)
 MIN_SPAN_S = 0.2  # s of wall time two reports must span before their pace counts
-NOMINAL_TOLERANCE = 0.25  # a measured pace within this fraction of the set one is taken as the set one
+TOO_SLOW = 0.5  # a measured pace below this share of the set one is believed (the machine cannot keep up)
 
 
 class RobotPace:
@@ -55,7 +55,7 @@ class RobotPace:
 
     @property
     def factor(self) -> float:
-        """Robot seconds per wall second: the set pace while the measurement agrees with it, else the
+        """Robot seconds per wall second: the set pace unless the measurement is far below it, then the
         measurement; 1 until measured (and none set)."""
         with self._lock:
             nominal = self._nominal
@@ -65,7 +65,7 @@ class RobotPace:
         if wall_1 - wall_0 < MIN_SPAN_S or robot_1 <= robot_0:
             return nominal or 1.0
         measured = (robot_1 - robot_0) / (wall_1 - wall_0)
-        if nominal is not None and abs(measured - nominal) <= NOMINAL_TOLERANCE * nominal:
+        if nominal is not None and measured >= TOO_SLOW * nominal:
             return nominal
         return measured
 
