@@ -244,7 +244,9 @@ def test_an_observable_command_with_a_wrong_token_is_refused_before_it_runs(cell
         assert dict(servicer.observable_command_managers["Undock"]) == {}  # sila2 created no execution
     finally:
         a.LockController.UnlockServer(LockIdentifier="holder")
-    assert base_pose(cell) == pose
+    # nothing moved: the localised pose of a standing base may differ in its last digits when a scan
+    # was matched in between (seen: 1e-10 m), a moved one by centimetres
+    assert base_pose(cell) == pytest.approx(pose, abs=1e-3)
     assert cell.robot_state() == "Docked"
 
 
