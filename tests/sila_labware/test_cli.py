@@ -243,9 +243,15 @@ def assert_run_pictures(record_dir: Path) -> None:
     assert (record_dir / "run.gif").stat().st_size > 1000
     head_frames = sorted((record_dir / "frames").glob("head_*.png"))
     assert len(head_frames) >= 2  # one sighting at each station
-    # the outline drawn around the detected marker is the detector's colour (255, 200, 0) in RGB
-    outlined = cv2.cvtColor(cv2.imread(str(head_frames[0])), cv2.COLOR_BGR2RGB)
-    assert (np.abs(outlined.astype(int) - (255, 200, 0)).sum(axis=2) < 30).sum() > 20
+
+    def outlined(frame: Path) -> bool:
+        """The outline drawn around a detected marker is the detector's colour (255, 200, 0) in RGB."""
+        rgb = cv2.cvtColor(cv2.imread(str(frame)), cv2.COLOR_BGR2RGB)
+        return (np.abs(rgb.astype(int) - (255, 200, 0)).sum(axis=2) < 30).sum() > 20
+
+    # not necessarily the first frame: a look taken while the torso still rose may miss the marker
+    # and the search looks again (seen once in CI); a depth image for the place has none either
+    assert sum(outlined(frame) for frame in head_frames) >= 2, "a marker sighting at each station"
 
 
 def test_serve_logs_each_refusal_as_one_warning_line_without_a_traceback(tmp_path: Path) -> None:
