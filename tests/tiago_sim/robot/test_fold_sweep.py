@@ -83,15 +83,17 @@ def test_folding_from_the_hotel_approach_sweeps_the_pads_over_a_bench_edge(
 
 @pytest.mark.parametrize("torso", [0.25, 0.35])
 @pytest.mark.parametrize("slot", [1, 2])
-@pytest.mark.parametrize("flip", [False, True])
 def test_folding_from_the_carry_height_keeps_the_pads_above_every_bench_top(
-    kinematics: RobotKinematics, torso: float, slot: int, flip: bool
+    kinematics: RobotKinematics, torso: float, slot: int
 ) -> None:
-    """What play_motion does now: rise to the carry height over the hotel (leave_hotel), then fold."""
+    """What play_motion does now: rise to the carry height over the hotel (leave_hotel), then fold,
+    from whichever grasp twin the arm reaches there (one of them always is)."""
     motions = load_motions()
-    start = hotel_start(kinematics, slot, flip, motions.hotel.carry_height_m, torso)
-    if start is None:
-        pytest.skip("this twin is out of the arm's reach at this torso height")
-    assert (
-        lowest_pad_ahead(kinematics, start, motions.frames_for("Tuck", ARM)[0]) > HIGHEST_BENCH_TOP_M + 0.05
-    )
+    starts = [
+        hotel_start(kinematics, slot, flip, motions.hotel.carry_height_m, torso) for flip in (False, True)
+    ]
+    reachable = [start for start in starts if start is not None]
+    assert reachable, "neither grasp twin over the hotel is in reach"
+    tuck = motions.frames_for("Tuck", ARM)[0]
+    for start in reachable:
+        assert lowest_pad_ahead(kinematics, start, tuck) > HIGHEST_BENCH_TOP_M + 0.05
