@@ -128,9 +128,7 @@ def _depth_plane(
     if np.count_nonzero(valid) < MIN_DEPTH_SAMPLES:
         return None
     z, rows, cols = z[valid], rows[valid], cols[valid]
-    points = np.column_stack(
-        [(cols - intrinsics.cx) / intrinsics.fx * z, (rows - intrinsics.cy) / intrinsics.fy * z, z]
-    )
+    points = intrinsics.back_project(cols, rows, z)
     origin = points.mean(axis=0)
     _, _, vt = np.linalg.svd(points - origin, full_matrices=False)
     normal = vt[2]

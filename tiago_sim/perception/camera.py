@@ -44,6 +44,10 @@ class CameraIntrinsics:
     near: float = 0.3
     far: float = 8.0
 
+    def back_project(self, cols: np.ndarray, rows: np.ndarray, z: np.ndarray) -> np.ndarray:
+        """Pixels (column, row) at depths ``z`` as points in the optical frame, shape (N, 3)."""
+        return np.column_stack([(cols - self.cx) / self.fx * z, (rows - self.cy) / self.fy * z, z])
+
     def matrix(self) -> np.ndarray:
         """3x3 camera matrix K, as OpenCV expects it."""
         return np.array([[self.fx, 0.0, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]])

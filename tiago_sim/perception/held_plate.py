@@ -65,10 +65,7 @@ def site_points(depth_m: np.ndarray, intrinsics: CameraIntrinsics, T_site_optica
     u, v = np.meshgrid(np.arange(width), np.arange(height))
     z = depth_m.reshape(-1)
     valid = np.isfinite(z) & (z > intrinsics.near) & (z < intrinsics.far)
-    z = z[valid]
-    x = (u.reshape(-1)[valid] - intrinsics.cx) / intrinsics.fx * z
-    y = (v.reshape(-1)[valid] - intrinsics.cy) / intrinsics.fy * z
-    optical = np.stack([x, y, z], axis=1)
+    optical = intrinsics.back_project(u.reshape(-1)[valid], v.reshape(-1)[valid], z[valid])
     return optical @ T_site_optical[:3, :3].T + T_site_optical[:3, 3]
 
 
