@@ -86,13 +86,19 @@ def service_problems(world) -> list[ServiceProblem]:  # noqa: ANN001 - a lab.wor
 
 def bench_distance(station, x: float, y: float) -> float:  # noqa: ANN001
     """Distance (m) from floor point (x, y) to the station's bench outline; negative inside it."""
+    return float(bench_distances(station, np.asarray(x, dtype=float), np.asarray(y, dtype=float)))
+
+
+def bench_distances(station, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:  # noqa: ANN001
+    """`bench_distance` for many floor points at once (a drive sampled every few centimetres)."""
     pose = station.table_pose
     c, s = math.cos(pose.yaw), math.sin(pose.yaw)
-    dx, dy = x - pose.x, y - pose.y
+    dx, dy = xs - pose.x, ys - pose.y
     depth, width = station.table_size[0], station.table_size[1]
-    local = (abs(c * dx + s * dy) - depth / 2, abs(-s * dx + c * dy) - width / 2)
-    outside = math.hypot(max(local[0], 0.0), max(local[1], 0.0))
-    return outside if outside > 0 else max(local)
+    along = np.abs(c * dx + s * dy) - depth / 2
+    across = np.abs(-s * dx + c * dy) - width / 2
+    outside = np.hypot(np.maximum(along, 0.0), np.maximum(across, 0.0))
+    return np.where(outside > 0, outside, np.maximum(along, across))
 
 
 def _footprint_problems(world) -> Iterator[ServiceProblem]:  # noqa: ANN001

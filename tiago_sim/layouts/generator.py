@@ -27,7 +27,15 @@ import random
 from dataclasses import dataclass
 from typing import Any
 
-from tiago_sim.lab.serviceability import BASE_RADIUS, HOTEL_SWEEP_RADIUS, TURN_MARGIN, bench_distance
+import numpy as np
+
+from tiago_sim.lab.serviceability import (
+    BASE_RADIUS,
+    HOTEL_SWEEP_RADIUS,
+    TURN_MARGIN,
+    bench_distance,
+    bench_distances,
+)
 from tiago_sim.lab.world import Pose2D, World, WorldError, world_from_raw
 from tiago_sim.lab.world_schema import MARKER_DICTIONARY_SIZE, MIRROR_AMBIGUOUS_MARKER_IDS
 from tiago_sim.layouts.station_draw import LABWARE_TYPES, RANGES, draw_station
@@ -161,15 +169,14 @@ def _bench_corners(station) -> list[tuple[float, float]]:  # noqa: ANN001 - a la
 
 
 def _segment_gap(start, end, station, step: float = 0.05) -> float:  # noqa: ANN001
-    """Least distance from the straight drive start -> end to the station's bench."""
+    """Least distance from the straight drive start -> end to the station's bench, sampled every
+    `step` along the drive (negative: it enters the bench)."""
     length = math.hypot(end.x - start.x, end.y - start.y)
     count = max(1, math.ceil(length / step))
-    return min(
-        bench_distance(
-            station, start.x + (end.x - start.x) * k / count, start.y + (end.y - start.y) * k / count
-        )
-        for k in range(count + 1)
-    )
+    k = np.arange(count + 1, dtype=float)
+    xs = start.x + (end.x - start.x) * k / count
+    ys = start.y + (end.y - start.y) * k / count
+    return float(bench_distances(station, xs, ys).min())
 
 
 def _plates(rng: random.Random, stations: list[dict[str, Any]]) -> list[dict[str, Any]]:
