@@ -12,8 +12,7 @@ from dataclasses import dataclass
 from itertools import combinations
 
 from tiago_sim.lab.world import World
-from tiago_sim.navigation.occupancy_map import build_map
-from tiago_sim.navigation.planner import GlobalPlanner, Plan, PlanningError
+from tiago_sim.navigation.planner import GlobalPlanner, Plan, PlanningError, world_planner
 
 
 @dataclass(frozen=True)
@@ -44,7 +43,7 @@ class PoiPaths:
 
 def plan_poi_paths(world: World) -> PoiPaths:
     """Plan from each POI to every later one (in the world's order: the dock's first)."""
-    planner = GlobalPlanner(build_map(world))
+    planner = world_planner(world)
     paths = []
     for (start_name, start), (goal_name, goal) in combinations(world.pois.items(), 2):
         try:

@@ -77,6 +77,11 @@ class Pose2D:
         return tf.from_planar(self.x, self.y, self.yaw, z)
 
 
+MARKER_BOARD_SCALE = 1.4
+"""The marker's board is this many times the marker's side, square, standing on the bench top behind
+the marker (physics.scene builds it)."""
+
+
 @dataclass(frozen=True)
 class Station:
     """A table with an ArUco marker and a row of nests (sub-positions 1..n)."""
@@ -105,6 +110,14 @@ class Station:
 
     def T_world_table(self) -> np.ndarray:
         return self.table_pose.matrix(self.table_size[2])
+
+    def marker_stand_height(self) -> float:
+        """How far the marker's board reaches above the bench top (m)."""
+        return self.marker_xyz[2] + self.marker_size * MARKER_BOARD_SCALE / 2
+
+    def top_height(self) -> float:
+        """The highest point of the bench and what stands on it (the marker's board), above the floor."""
+        return self.table_size[2] + max(0.0, self.marker_stand_height())
 
     def T_table_marker(self) -> np.ndarray:
         return tf.from_xyz_rpy(self.marker_xyz, self.marker_rpy)

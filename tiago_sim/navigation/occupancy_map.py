@@ -13,13 +13,14 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from tiago_sim.lab.world import World
+from tiago_sim.lab.world import MARKER_BOARD_SCALE, World
 from tiago_sim.robot.robot_model import BASE_RADIUS
 
 DEFAULT_RESOLUTION = 0.05  # m per cell (the ROS 2 navigation stack's usual resolution)
 WALL_THICKNESS = 0.10  # m: the floor's edge is a wall this thick, inside the floor
 DOCK_GAP = 0.002  # m between the docked robot's rear and the dock's contact plate
 DOCK_SIZE = (0.10, 0.45, 0.30)  # m: depth (along the docked heading), width, height
+BOARD_BAND = 0.04  # m: a marker board (1 cm thick, 6 mm behind the marker) as a strip on the map
 
 
 @dataclass(frozen=True)
@@ -88,17 +89,31 @@ class OccupancyMap:
         return OccupancyMap(self.resolution, self.origin, grid.astype(bool))
 
 
-def station_footprints(world: World) -> list[Footprint]:
-    """Every bench's outline."""
+def station_footprints(world: World, above_m: float = 0.0) -> list[Footprint]:
+    """Every bench's outline; with `above_m`, the benches whose top is higher, and of a lower bench
+    the marker's board where that reaches higher (a thin strip along the marker's x axis)."""
+    footprints = []
+    for s in world.stations:
+        if s.table_size[2] > above_m:
+            footprints.append(
+                Footprint(s.table_pose.x, s.table_pose.y, s.table_pose.yaw, s.table_size[0], s.table_size[1])
+            )
+        elif s.top_height() > above_m:
+            T_world_marker = s.T_world_marker()
+            x, y = T_world_marker[:2, 3]
+            yaw = math.atan2(T_world_marker[1, 0], T_world_marker[0, 0])
+            footprints.append(
+                Footprint(float(x), float(y), yaw, s.marker_size * MARKER_BOARD_SCALE, BOARD_BAND)
+            )
+    return footprints
+
+
+def obstacle_footprints(world: World, above_m: float = 0.0) -> list[Footprint]:
+    """Every free-standing obstacle's outline (boxes and cylinders of the world file) taller than
+    `above_m`."""
     return [
-        Footprint(s.table_pose.x, s.table_pose.y, s.table_pose.yaw, s.table_size[0], s.table_size[1])
-        for s in world.stations
+        Footprint(o.x, o.y, o.yaw, o.length, o.width, o.radius) for o in world.obstacles if o.height > above_m
     ]
-
-
-def obstacle_footprints(world: World) -> list[Footprint]:
-    """Every free-standing obstacle's outline (boxes and cylinders of the world file)."""
-    return [Footprint(o.x, o.y, o.yaw, o.length, o.width, o.radius) for o in world.obstacles]
 
 
 def dock_footprint(world: World) -> Footprint:
@@ -110,8 +125,9 @@ def dock_footprint(world: World) -> Footprint:
     )
 
 
-def build_map(world: World, resolution: float = DEFAULT_RESOLUTION) -> OccupancyMap:
-    """The static map: the floor's edge walls, the dock, every bench and every free-standing obstacle."""
+def build_map(world: World, resolution: float = DEFAULT_RESOLUTION, above_m: float = 0.0) -> OccupancyMap:
+    """The static map: the floor's edge walls, the dock, every bench and every free-standing obstacle;
+    with `above_m`, only what reaches higher than that (the walls always: what the folded arms meet)."""
     half = world.floor_size / 2
     cells = math.ceil(world.floor_size / resolution)
     empty = OccupancyMap(resolution, (-half, -half), np.zeros((cells, cells), dtype=bool))
@@ -120,8 +136,9 @@ def build_map(world: World, resolution: float = DEFAULT_RESOLUTION) -> Occupancy
     grid[:wall_cells, :] = grid[-wall_cells:, :] = True
     grid[:, :wall_cells] = grid[:, -wall_cells:] = True
     walled = OccupancyMap(resolution, empty.origin, grid)
+    dock = [dock_footprint(world)] if DOCK_SIZE[2] > above_m else []
     return walled.with_footprints(
-        [dock_footprint(world), *station_footprints(world), *obstacle_footprints(world)]
+        [*dock, *station_footprints(world, above_m), *obstacle_footprints(world, above_m)]
     )
 
 

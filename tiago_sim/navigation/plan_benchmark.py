@@ -18,8 +18,7 @@ import time
 import numpy as np
 
 from tiago_sim.lab.world import load_world
-from tiago_sim.navigation.occupancy_map import build_map
-from tiago_sim.navigation.planner import GlobalPlanner, PlanningError
+from tiago_sim.navigation.planner import PlanningError, world_planner
 
 BENCH_IN_THE_WAY = "tiago_sim/worlds/bench_in_the_way.yaml"
 
@@ -28,7 +27,7 @@ def measure(world_file: str, plans: int, seed: int) -> dict[str, float]:
     """Milliseconds per plan (median, 90th percentile, max; the median of those that needed the grid
     search, not a straight line) and how many found no path."""
     world = load_world(world_file)
-    planner = GlobalPlanner(build_map(world))
+    planner = world_planner(world)
     free = np.argwhere(~planner.inflated.occupied)
     rng = np.random.default_rng(seed)
     times_ms, detour_ms, failed = [], [], 0

@@ -18,8 +18,13 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
 from tiago_sim.lab.world import DEFAULT_WORLD, load_world
-from tiago_sim.navigation.occupancy_map import build_map
-from tiago_sim.navigation.planner import INFLATION_RADIUS_M, ROBOT_RADIUS_M, GlobalPlanner, Plan
+from tiago_sim.navigation.planner import (
+    INFLATION_RADIUS_M,
+    ROBOT_RADIUS_M,
+    GlobalPlanner,
+    Plan,
+    world_planner,
+)
 
 
 def draw_plan(planner: GlobalPlanner, plan: Plan, title: str, path: Path) -> None:
@@ -64,7 +69,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--png", type=Path, required=True)
     args = parser.parse_args(argv)
     world = load_world(args.world)
-    planner = GlobalPlanner(build_map(world))
+    planner = world_planner(world)
     start, goal = world.pois[args.start], world.pois[args.goal]
     plan = planner.plan((start.x, start.y, start.yaw), (goal.x, goal.y, goal.yaw))
     draw_plan(planner, plan, f"{world.name}: {args.start} -> {args.goal}", args.png)

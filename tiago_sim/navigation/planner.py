@@ -28,7 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tiago_sim.navigation.occupancy_map import OccupancyMap
+from tiago_sim.lab.world import World
+from tiago_sim.navigation.occupancy_map import OccupancyMap, build_map
 from tiago_sim.robot.hotel_model import HOTEL_POCKET_SIZE, HOTEL_SLOT_XYZ
 from tiago_sim.robot.robot_model import BASE_RADIUS
 
@@ -55,7 +56,16 @@ INFLATION_MARGIN_M = 0.05
 the end of a drive) plus 2 cm."""
 INFLATION_RADIUS_M = ROBOT_RADIUS_M + INFLATION_MARGIN_M
 FOOTPRINT_MARGIN_M = 0.03
-"""Around the base's own radius on the straight segment leaving or entering the inflated zone."""
+"""Around the base's own radius on the straight segment leaving or entering the inflated zone, and
+beyond the folded arms' sideways reach along it (the path follower's and localisation's error)."""
+ARMS_LOWEST_M = 0.74
+"""The folded arms' lowest point beside the base in the travel pose (arm_*_4_link, torso at 0.15 m)."""
+ARMS_CLEAR_ABOVE_M = ARMS_LOWEST_M - 0.05
+"""What stands no higher than this passes under the folded arms (a low bench: `build_map(above_m=)`)."""
+ARMS_HALF_WIDTH_M = ARM_SWEEP_RADIUS_M + FOOTPRINT_MARGIN_M
+"""Half the width of the band the folded arms sweep on a straight segment: an obstacle beside the
+segment within this is touched by an arm even where the base passes it with room to spare (an arm
+grazed a fridge beside such a segment: campaign seed 98045)."""
 COMFORT_M = 0.15
 """Straight segments keep this much more than the inflation from obstacles where the room allows."""
 COST_RANGE_M = 0.40
@@ -90,6 +100,21 @@ def _coarsened(grid: OccupancyMap, cost: np.ndarray, factor: int) -> tuple[Occup
     return OccupancyMap(grid.resolution * factor, grid.origin, blocks), block_cost
 
 
+def _points_free(grid: OccupancyMap, xs: np.ndarray, ys: np.ndarray) -> bool:
+    """Every point (x, y) lies in a free cell of the grid (off the grid counts as occupied)."""
+    rows = np.floor((ys - grid.origin[1]) / grid.resolution).astype(int)
+    cols = np.floor((xs - grid.origin[0]) / grid.resolution).astype(int)
+    height, width = grid.shape
+    if rows.min() < 0 or cols.min() < 0 or rows.max() >= height or cols.max() >= width:
+        return False
+    return not bool(grid.occupied[rows, cols].any())
+
+
+def world_planner(world: World) -> GlobalPlanner:
+    """The planner for a world's static map, knowing which benches the folded arms pass over."""
+    return GlobalPlanner(build_map(world), build_map(world, above_m=ARMS_CLEAR_ABOVE_M))
+
+
 class PlanningError(Exception):
     """No path: ``reason`` says why in words ("the goal (1.20, 3.40) is inside an obstacle")."""
 
@@ -116,8 +141,11 @@ class Plan:
 class GlobalPlanner:
     """Plans on one static map; build once per map (the inflation and cost grids are cached)."""
 
-    def __init__(self, static_map: OccupancyMap) -> None:
+    def __init__(self, static_map: OccupancyMap, arms_map: OccupancyMap | None = None) -> None:
+        """`arms_map`: what reaches the folded arms' height (`build_map(world, above_m=ARMS_CLEAR_ABOVE_M)`;
+        default: everything on the static map, as for obstacles of unknown height)."""
         self.static_map = static_map
+        self.arms_map = static_map if arms_map is None else arms_map
         clearance = static_map.clearance_m()
         self.clearance = clearance
         self.inflated = static_map.inflated(INFLATION_RADIUS_M)
@@ -183,10 +211,12 @@ class GlobalPlanner:
         step = self.static_map.resolution / 2
         for direction in directions:
             dx, dy = math.cos(direction), math.sin(direction)
+            if not self._arms_clear((x, y), direction):
+                continue
             distance = step
             while distance <= ESCAPE_MAX_M:
                 point = (x + dx * distance, y + dy * distance)
-                if not self.footprint.is_free(*point):
+                if not self.footprint.is_free(*point) or not self._arms_clear(point, direction):
                     break
                 if self.inflated.is_free(*point):
                     if best is None or distance < best[0]:
@@ -203,7 +233,8 @@ class GlobalPlanner:
             raise PlanningError(
                 f"the {what} ({x:.2f}, {y:.2f}) is {self.clearance[row, col]:.2f} m from an obstacle and "
                 f"no straight segment {rule} reaches {INFLATION_RADIUS_M:.2f} m clearance "
-                f"within {ESCAPE_MAX_M} m"
+                f"within {ESCAPE_MAX_M} m with nothing within {ARMS_HALF_WIDTH_M:.2f} m beside it "
+                "(the folded arms)"
             )
         return best[1], best[2]
 
@@ -280,18 +311,20 @@ class GlobalPlanner:
         return cells[::-1]
 
     # -- straight segments ----------------------------------------------------------------
+    def _arms_clear(self, point: tuple[float, float], direction: float) -> bool:
+        """Nothing as high as the folded arms beside `point` within their reach, across a straight
+        segment driven along `direction` (the line through the point at right angles to it)."""
+        grid = self.arms_map
+        offsets = np.arange(-ARMS_HALF_WIDTH_M, ARMS_HALF_WIDTH_M + 1e-9, grid.resolution / 2)
+        return _points_free(
+            grid, point[0] - math.sin(direction) * offsets, point[1] + math.cos(direction) * offsets
+        )
+
     def _segment_free(self, grid: OccupancyMap, a: tuple[float, float], b: tuple[float, float]) -> bool:
         """Every point of the segment lies in a free cell (sampled at a quarter cell)."""
         samples = max(2, int(math.dist(a, b) / (grid.resolution / 4)) + 1)
         t = np.linspace(0.0, 1.0, samples)
-        xs = a[0] + (b[0] - a[0]) * t
-        ys = a[1] + (b[1] - a[1]) * t
-        rows = np.floor((ys - grid.origin[1]) / grid.resolution).astype(int)
-        cols = np.floor((xs - grid.origin[0]) / grid.resolution).astype(int)
-        height, width = grid.shape
-        if rows.min() < 0 or cols.min() < 0 or rows.max() >= height or cols.max() >= width:
-            return False
-        return not bool(grid.occupied[rows, cols].any())
+        return _points_free(grid, a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t)
 
     def _shortcut(self, points: list[tuple[float, float]]) -> list[tuple[float, float]]:
         """Greedy line of sight: from each kept point, on to the farthest one in sight (comfort

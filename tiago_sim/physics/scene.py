@@ -19,7 +19,7 @@ import pybullet as p
 from labware_model.holders import HotelSlot, Nest
 from labware_model.labware import LabwareType
 from tiago_sim import transforms as tf
-from tiago_sim.lab.world import Obstacle, Station, World
+from tiago_sim.lab.world import MARKER_BOARD_SCALE, Obstacle, Station, World
 from tiago_sim.navigation.occupancy_map import DOCK_GAP, DOCK_SIZE, WALL_THICKNESS
 from tiago_sim.perception.marker_asset import marker_visual
 from tiago_sim.robot.hotel_model import corner_ramp_boxes
@@ -119,8 +119,8 @@ def _build_station(client: int, station: Station, labware: LabwareType, scene: S
     p.changeDynamics(scene.tables[station.name], -1, lateralFriction=TABLE_FRICTION, physicsClientId=client)
     # marker on a thin board standing behind it
     T_world_marker = station.T_world_marker()
-    board = station.marker_size * 1.4
-    stand_height = station.marker_xyz[2] + board / 2
+    board = station.marker_size * MARKER_BOARD_SCALE
+    stand_height = station.marker_stand_height()
     T_world_board = T_world_marker @ tf.make_transform((0, stand_height / 2 - station.marker_xyz[2], -0.006))
     scene.marker_stands[station.name] = _static_box(
         client, (board, stand_height, 0.01), T_world_board, [0.95, 0.95, 0.95, 1]

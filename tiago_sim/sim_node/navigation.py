@@ -29,7 +29,7 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from tiago_sim.lab.world import World
 from tiago_sim.navigation.blockage import UnmappedObstacles, marks, still_there
 from tiago_sim.navigation.occupancy_map import OccupancyMap, build_map
-from tiago_sim.navigation.planner import GlobalPlanner, Plan, PlanningError
+from tiago_sim.navigation.planner import GlobalPlanner, Plan, PlanningError, world_planner
 from tiago_sim.physics.guarded_path import PATH_BLOCKED, scan_in_map
 from tiago_sim.sim_node.action_run import ActionAbort, ActionRun
 from tiago_sim.sim_node.publishers import stamp_of
@@ -89,7 +89,7 @@ class Navigation:
 
     def __init__(self, node: Node, world: World) -> None:
         self.static_map = build_map(world)
-        self.planner = GlobalPlanner(self.static_map)
+        self.planner = world_planner(world)
         latched = QoSProfile(
             depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
         )
@@ -164,14 +164,18 @@ class Navigation:
     ) -> Plan:
         """A plan on the static map, or on a local copy with the seen obstacles marked."""
         local = self.static_map.with_footprints(marks(seen)) if len(seen) else None
-        planner = self.planner if local is None else GlobalPlanner(local)
+        if local is None:
+            planner = self.planner
+        else:  # what the laser saw has no known height: the arms must keep clear of it too
+            planner = GlobalPlanner(local, self.planner.arms_map.with_footprints(marks(seen)))
         plan = planner.plan(start, goal)
         log.info(
-            "plan: %d waypoints, %.2f m, %.1f ms%s",
+            "plan: %d waypoints, %.2f m, %.1f ms%s: %s",
             len(plan.waypoints),
             plan.length_m,
             plan.planning_s * 1000,
             f" ({len(seen)} points not on the map marked)" if len(seen) else "",
+            " -> ".join(f"({x:.2f}, {y:.2f})" for x, y in plan.waypoints),
         )
         return plan
 

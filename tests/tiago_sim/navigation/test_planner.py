@@ -8,11 +8,15 @@ import math
 import numpy as np
 import pytest
 
-from tiago_sim.lab.world import DEFAULT_WORLD, load_world
+from tiago_sim.lab.world import DEFAULT_WORLD, load_world, world_from_raw
+from tiago_sim.lab.world_obstacles import KEEP_CLEAR_M
+from tiago_sim.layouts.generator import generate_layout
+from tiago_sim.measuring.disturbances import DisturbanceLevels
 from tiago_sim.navigation.occupancy_map import Footprint, OccupancyMap, build_map
 from tiago_sim.navigation.plan_benchmark import measure
 from tiago_sim.navigation.planner import (
     ARM_SWEEP_RADIUS_M,
+    ARMS_CLEAR_ABOVE_M,
     INFLATION_RADIUS_M,
     ROBOT_RADIUS_M,
     GlobalPlanner,
@@ -122,3 +126,37 @@ def test_median_planning_time_on_a_12_m_map_is_under_50_ms() -> None:
     result = measure(str(BENCH_IN_THE_WAY), plans=60, seed=3)
     assert result["cells"] == 240 * 240
     assert result["median_ms"] <= 50.0 and result["detour_median_ms"] <= 50.0, result
+
+
+def test_a_straight_entry_past_a_tall_obstacle_within_the_arms_reach_is_refused() -> None:
+    """Seed 98045: the goal could not be turned at, so it was entered along its heading, 1.25 m
+    past a fridge 0.47 m beside the lane; the base had room, a folded arm grazed the fridge."""
+    bench = Footprint(1.0, 0.0, 0.0, 0.7, 1.0)  # front edge at x 0.65; the goal faces it
+    fridge = Footprint(-0.3, -0.47 - 0.3, 0.0, 1.0, 0.6)  # its near side 0.47 m right of the lane
+    goal = (0.65 - 0.32, 0.0, 0.0)
+    planner = GlobalPlanner(room(bench, fridge))
+    with pytest.raises(PlanningError, match="folded arms"):
+        planner.plan((-2.0, 2.0, 0.0), goal)
+    low_cabinet = room(bench)  # the same box, but under the arms: only the bench reaches them
+    plan = GlobalPlanner(room(bench, fridge), arms_map=low_cabinet).plan((-2.0, 2.0, 0.0), goal)
+    assert plan.waypoints[-1] == goal[:2]
+
+
+def test_the_arms_map_keeps_a_low_bench_but_not_its_tall_marker_board() -> None:
+    world = world_from_raw(generate_layout(12), "layout 12")
+    (station,) = [s for s in world.stations if s.name == "labeler"]  # a 0.64 m bench
+    above = ARMS_CLEAR_ABOVE_M
+    assert station.table_size[2] < above < station.top_height()  # a low bench with a tall board
+    arms_map = build_map(world, above_m=above)
+    static_map = build_map(world)
+    bench_cells = static_map.occupied.sum() - arms_map.occupied.sum()
+    assert bench_cells > 0
+    marker = station.T_world_marker()[:2, 3]
+    assert not arms_map.is_free(*marker)  # the board is on the arms' map
+    assert arms_map.is_free(station.table_pose.x, station.table_pose.y)  # the low bench top is not
+
+
+def test_the_obstacles_keep_clear_covers_the_planner_and_the_navigation_error() -> None:
+    """A POI the robot stops up to 3 sigma off (per axis) is still one the planner accepts."""
+    three_sigma = 3 * DisturbanceLevels().navigation_xy_m
+    assert KEEP_CLEAR_M >= INFLATION_RADIUS_M + three_sigma
