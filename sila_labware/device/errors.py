@@ -2,7 +2,9 @@
 
 `CommandSequenceError` becomes the standard's defined error InvalidCommandSequence;
 `ParameterError` becomes a SiLA validation error naming the parameter; `TransferFailed` becomes
-LabwareNotPicked or LabwareNotPlaced, `MotionFailed` the MobileRobotController error for its code.
+LabwareNotPicked or LabwareNotPlaced, `MotionFailed` the MobileRobotController error for its code
+(in a labware transfer command: InvalidCommandSequence from Prepare*, whose drive left nothing
+prepared; LabwareNotPicked/LabwareNotPlaced from GetLabware/PutLabware).
 """
 
 from __future__ import annotations

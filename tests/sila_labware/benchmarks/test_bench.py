@@ -109,9 +109,10 @@ def test_disturbances_are_seeded_and_move_the_true_world_only() -> None:
             "perception",
         ),
         (
-            "UndefinedServerError: Robot.PrepareForOutput (step B.PrepareForInput + Robot.PrepareForOutput): "
-            "RuntimeError - PrepareForOutput failed while driving: driving to station_b_work failed "
-            "(MOTION_FAILED): stalled",
+            "InvalidCommandSequence: Robot.PrepareForOutput (step B.PrepareForInput + "
+            "Robot.PrepareForOutput): PrepareForOutput could not bring the robot to the handover position, "
+            "so nothing is prepared: "
+            "driving to station_b_work failed (MOTION_FAILED): stalled; the robot stands where it stopped",
             "navigation",
         ),
         ("LabwareNotPlaced: Robot.PutLabware: PutLabware failed (MOTION_FAILED): arm stalled", "positioning"),

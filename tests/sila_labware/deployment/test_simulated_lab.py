@@ -111,6 +111,21 @@ def test_a_path_closed_mid_drive_fails_the_drive_with_navigation_failed(cell: Ce
     reset(cell)
 
 
+def test_a_path_closed_during_prepare_is_the_standards_error_and_nothing_stays_prepared(cell: Cell) -> None:
+    lab = lab_controls(cell)
+    lab.SetPace(Pace=10.0)  # the robot waits 20 s of simulated time for a way round
+    lab.InjectFault(Fault="BlockPath", Target="closed")
+    with pytest.raises(DefinedExecutionError, match="InvalidCommandSequence") as failure:
+        cell.prepare_pick(A1, PLATE, station_too=False)
+    assert "nothing is prepared" in str(failure.value) and "NAVIGATION_FAILED" in str(failure.value)
+    with pytest.raises(DefinedExecutionError, match="InvalidCommandSequence"):
+        cell.pick(A1)  # not prepared: refused before anything moves
+    assert cell.deployment.link.check_placement(PLATE, Nest(*A1)).in_nest
+    lab.ClearFaults()
+    lab.SetPace(Pace=0.0)
+    reset(cell)
+
+
 def test_an_occluded_marker_fails_the_pick_and_clearing_the_fault_lets_it_run(cell: Cell) -> None:
     lab = lab_controls(cell)
     lab.InjectFault(Fault="OccludeMarker", Target="station_a")

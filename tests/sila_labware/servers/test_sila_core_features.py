@@ -342,8 +342,9 @@ def test_cancel_command_ends_a_running_prepare_and_the_protocol_starts_over(
     wait_for_progress(prepare, 0.05)
     cancel(cell, prepare)
     error = end_of(prepare)
-    # The standard gives PrepareForInput no error for a drive that did not arrive: an undefined one.
-    assert isinstance(error, UndefinedExecutionError), repr(error)
+    # The standard's one error of PrepareForInput: the drive did not arrive, nothing is prepared.
+    assert isinstance(error, DefinedExecutionError), repr(error)
+    assert error.identifier == "InvalidCommandSequence" and "nothing is prepared" in error.message
     assert "cancelled by a client (CancelController.CancelCommand)" in error.message, error.message
     set_node_parameter(cell.deployment.runtime, "realtime_factor_cap", 0.0)
     wait_idle(cell)  # the state topic's last report of the motion (it lags the command's end)

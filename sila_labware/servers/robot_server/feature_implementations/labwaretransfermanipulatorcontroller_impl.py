@@ -163,6 +163,12 @@ class LabwareTransferManipulatorControllerImpl(LabwareTransferManipulatorControl
         except ParameterError as error:
             raise validation_error(LabwareTransferManipulatorControllerFeature, command, error) from error
         except MotionFailed as error:
-            # The standard defines no error for a failed (or cancelled) approach drive: an undefined
-            # execution error, whose message names the cancel when there was one.
-            raise RuntimeError(f"{command} failed while driving: {error.message}") from error
+            if command.startswith("Prepare"):
+                # The standard gives Prepare* one defined error. A drive that did not arrive (blocked,
+                # a collision, a cancel) leaves nothing prepared: the handover cannot go on in this
+                # order, and a GetLabware/PutLabware now would be refused the same way.
+                raise InvalidCommandSequence(
+                    f"{command} could not bring the robot to the handover position, so nothing is "
+                    f"prepared: {error.message}; the robot stands where it stopped"
+                ) from error
+            raise TransferFailed(error.error_code, error.message) from error  # the command's own error
