@@ -5,8 +5,9 @@ at the bench (issue 14). These four checks refuse it before anything moves, from
 geometry (tiago_sim.robot), each with its numbers:
 
 - footprint: the base (radius `BASE_RADIUS`) at the docked pose overlaps a bench; at a station's
-  working pose the hotel tray's turning circle (`HOTEL_SWEEP_RADIUS`) does: the final alignment
-  turns the base a few degrees there. With bench edges 0.32 to 0.34 m ahead, `Benchtop`, `Tuck`
+  working pose the hotel tray's turning circle (`HOTEL_SWEEP_RADIUS`) plus where the marker-guided
+  final approach may end (`WORKING_CLEARANCE`) does: that approach drives at the bearing to the
+  working pose and turns to the bench there. With bench edges 0.32 to 0.34 m ahead, `Benchtop`, `Tuck`
   and `NestApproach` stopped with head or arm joints off their goals (random layouts 80003, 80005,
   80010, 80019 at 414b4a6, reproducible with `bench --replay`); in a direct reproduction the base
   link, which carries the tray, pressed into the bench with kilonewtons and shook torso and head;
@@ -33,14 +34,29 @@ import numpy as np
 
 from tiago_sim import transforms as tf
 from tiago_sim.robot import robot_model
+from tiago_sim.robot.hotel_model import hotel_sweep_radius
 from tiago_sim.robot.kinematics import CAMERA_FRAME, RobotKinematics, head_angles_towards
 from tiago_sim.robot.motion_library import HotelGrasp, load_motions
 
 BASE_RADIUS = robot_model.BASE_RADIUS
-HOTEL_SWEEP_RADIUS = 0.35
-"""The onboard hotel tray's farthest corner from the base centre (m): the circle a turn sweeps."""
+HOTEL_SWEEP_RADIUS = hotel_sweep_radius()
+"""The onboard hotel tray's farthest corner from the base centre (m): the circle a turn sweeps (0.354)."""
 TURN_MARGIN = 0.05
 """Navigation stops up to a few cm off its POI (30 mm per axis, one sigma, by default)."""
+ALIGN_SIGHTING_ERROR = 0.010
+"""How much nearer the bench the working pose the marker shows from the POI may lie than the real one
+(m): the head camera's calibration (mount 1 mm and 0.1 deg per axis, head encoder zeros 0.1 deg, depth
+bias 1 mm at 1 m; one sigma each) over the 0.7 to 0.9 m to the marker, at three sigma. Random layout
+92012 measured 7.0 mm from draws of about two sigma."""
+ALIGN_DRIVE_OVERSHOOT = 0.006
+"""How far the final approach's drive passes its goal's line towards the bench (m): closing on a goal
+beside its heading, the drive curves in and crosses the line by up to 5.6 mm (0.21 m ahead, 0 to
+0.1 m aside; 5 mm at 92012) before it stops and turns."""
+WORKING_CLEARANCE = HOTEL_SWEEP_RADIUS + ALIGN_SIGHTING_ERROR + ALIGN_DRIVE_OVERSHOOT
+"""A working pose's least distance from every bench (m): the tray's turning circle, which the final
+approach sweeps in part (it drives at the bearing to the working pose, then turns to the bench), plus
+where that approach may end. At 0.361 m, with the circle taken as 0.35 and no margin, the tray touched
+the bench (random layout 92012: the base 12 mm nearer than its working pose, turned 28 deg)."""
 REACH_ARM = "right"
 LOOK_TORSO_LIFT = 0.15
 """The torso height of "Home", where the first look at a station's marker is taken (m)."""
@@ -113,7 +129,10 @@ def _footprint_problems(world) -> Iterator[ServiceProblem]:  # noqa: ANN001
 def _clear(label: str, pose, radius: float, station) -> Iterator[str]:  # noqa: ANN001
     gap = bench_distance(station, pose.x, pose.y)
     if gap < radius:
-        need = "its footprint" if radius == BASE_RADIUS else "the hotel tray's turning circle"
+        need = {
+            BASE_RADIUS: "its footprint",
+            WORKING_CLEARANCE: "the hotel tray's turning circle and the final approach's error",
+        }.get(radius, "the hotel tray's turning circle and the navigation error")
         yield (
             f"{label} at x {pose.x:.3f} y {pose.y:.3f} m is {gap:.3f} m from bench {station.name!r}; "
             f"{need} needs {radius:.3f} m"
@@ -127,7 +146,7 @@ def _station_problems(world, station) -> list[str]:  # noqa: ANN001
         turning = HOTEL_SWEEP_RADIUS + TURN_MARGIN
         problems += _clear(f"{station.name!r}: the base at POI {station.poi}", poi, turning, other)
         problems += _clear(
-            f"{station.name!r}: the base at the working pose", working, HOTEL_SWEEP_RADIUS, other
+            f"{station.name!r}: the base at the working pose", working, WORKING_CLEARANCE, other
         )
     problems += _reach_problems(station, working)
     for label, pose in ((f"POI {station.poi}", poi), ("the working pose", working)):

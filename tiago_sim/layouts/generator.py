@@ -33,6 +33,7 @@ from tiago_sim.lab.serviceability import (
     BASE_RADIUS,
     HOTEL_SWEEP_RADIUS,
     TURN_MARGIN,
+    WORKING_CLEARANCE,
     bench_distance,
     bench_distances,
 )
@@ -44,7 +45,6 @@ STATION_NAMES = ("reader", "sealer", "incubator", "washer", "dispenser", "centri
 MARKER_IDS = tuple(i for i in range(MARKER_DICTIONARY_SIZE) if i not in MIRROR_AMBIGUOUS_MARKER_IDS)
 WALL_MARGIN = 0.3  # m between anything the robot uses and the floor's edge (walls 0.1 m thick)
 CORRIDOR = HOTEL_SWEEP_RADIUS + TURN_MARGIN
-WORKING_CLEARANCE = HOTEL_SWEEP_RADIUS + 0.01  # the base at a working pose, from every bench
 PLACEMENT_TRIES = 300  # per station, before the whole floor is drawn again
 LAYOUT_TRIES = 50
 

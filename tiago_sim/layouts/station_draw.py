@@ -14,6 +14,8 @@ from __future__ import annotations
 import random
 from typing import Any
 
+from tiago_sim.lab.serviceability import WORKING_CLEARANCE
+
 RANGES: dict[str, Any] = {
     "stations": (2, 6),
     "floor_size": (8.0, 10.0),  # m, plus 0.5 m per station
@@ -42,7 +44,7 @@ LABWARE_TYPES: dict[str, dict[str, float]] = {
 }
 NEST_HALF_EXTENT = 0.07  # m: half a plate's length plus the brackets' lead-in, along the row
 EDGE_MARGIN = 0.03  # m between a nest or the marker and the bench's side
-WORKING_EDGE = 0.36  # m: the loader's 0.35 m (the hotel tray's turning circle) and 1 cm for alignment
+WORKING_EDGE = WORKING_CLEARANCE  # m: the loader's, the tray's turning circle and the final approach's error
 
 
 def _between(rng: random.Random, key: str, digits: int = 3) -> float:

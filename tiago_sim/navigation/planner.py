@@ -30,18 +30,8 @@ import numpy as np
 
 from tiago_sim.lab.world import World
 from tiago_sim.navigation.occupancy_map import OccupancyMap, build_map
-from tiago_sim.robot.hotel_model import HOTEL_POCKET_SIZE, HOTEL_SLOT_XYZ
+from tiago_sim.robot.hotel_model import hotel_sweep_radius
 from tiago_sim.robot.robot_model import BASE_RADIUS
-
-
-def hotel_sweep_radius() -> float:
-    """The hotel tray's farthest corner from the base centre (the tray plate is the pocket plus
-    3 cm along x and 2 cm across, hotel_model.add_hotel): 0.354 m."""
-    length, width = HOTEL_POCKET_SIZE
-    return max(
-        math.hypot(abs(x) + (length + 0.03) / 2, abs(y) + (width + 0.02) / 2) for x, y, _ in HOTEL_SLOT_XYZ
-    )
-
 
 ARM_SWEEP_RADIUS_M = 0.48
 """The folded arms' farthest point from the base centre in the travel pose (Home/Tuck, torso at

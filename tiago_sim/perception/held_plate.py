@@ -105,7 +105,13 @@ def locate_held_plate(
     on_top = near & (np.abs(points[:, 2] - top) < TOP_BAND_M)
     along = points[on_top & inner]
     x_low, x_high = _extent(along[:, 0])
-    beyond_pads = on_top & (np.abs(points[:, 0] - tool_x) > pad_width / 2 + BEYOND_PADS_M)
+    # The pads stand off the arm's tool position (joint readings) by the camera's calibration error
+    # against the arm's, and off the plate's centre by where the hand holds it: either can be several
+    # millimetres (random layout 99012: the pads seen 7 mm off the tool, their outer faces taken for
+    # the plate's edges, 95 mm wide). The pads lie within both spans, so both are left out.
+    pads_low = min(tool_x, (x_low + x_high) / 2) - pad_width / 2 - BEYOND_PADS_M
+    pads_high = max(tool_x, (x_low + x_high) / 2) + pad_width / 2 + BEYOND_PADS_M
+    beyond_pads = on_top & ((points[:, 0] < pads_low) | (points[:, 0] > pads_high))
     within_ends = (points[:, 0] > x_low + 0.004) & (points[:, 0] < x_high - 0.004)
     across = points[beyond_pads & within_ends]
     if len(along) < MIN_POINTS or len(across) < MIN_POINTS:

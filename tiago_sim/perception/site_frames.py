@@ -86,3 +86,27 @@ def upright_marker(T_base_marker: np.ndarray, T_table_marker: np.ndarray) -> np.
     upright = np.asarray(T_base_marker, dtype=float).copy()
     upright[:3, :3] = T_base_table[:3, :3] @ np.asarray(T_table_marker, dtype=float)[:3, :3]
     return upright
+
+
+def at_height(T_base_frame: np.ndarray, height_m: float) -> np.ndarray:
+    """The same pose at ``height_m`` above the floor the base stands on (base_footprint's z = 0).
+
+    Why: a nest's height is the bench's, which the world file gives and no bench shift changes, while
+    the height a marker sighting gives carries the head camera's calibration (its tilt over the 0.6 to
+    0.9 m to the marker) and the marker's own mounting on its stand. Both reach several millimetres:
+    in default-lab seed 96195 the marker was seen 3.6 mm high and glued 2.7 mm up its stand, the nest
+    believed 6.3 mm high, and the finger pads closed over the plate's top ("nothing between the
+    fingers"). Position along the floor still comes from the marker: benches move on the floor.
+    """
+    moved = np.asarray(T_base_frame, dtype=float).copy()
+    moved[2, 3] = float(height_m)
+    return moved
+
+
+def nest_in_base(
+    T_base_marker_seen: np.ndarray, T_table_marker: np.ndarray, T_marker_site: np.ndarray, height_m: float
+) -> np.ndarray:
+    """A nest frame (site or approach) in base_footprint from a marker sighting: level, its heading and
+    floor position from the sighting (``upright_marker``), its height from the bench (``at_height``)."""
+    T_base_marker = upright_marker(T_base_marker_seen, T_table_marker)
+    return at_height(levelled(T_base_marker @ np.asarray(T_marker_site, dtype=float)), height_m)

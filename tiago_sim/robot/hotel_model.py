@@ -15,6 +15,7 @@ from tiago_sim.robot.urdf_writer import UrdfWriter
 # Hotel (onboard plate holder): pocket floors on the base front, reachable top-down by either arm
 HOTEL_SLOT_XYZ = ((0.25, -0.07, 0.60), (0.25, 0.07, 0.60))
 HOTEL_POCKET_SIZE = (0.1318, 0.0895)  # inner length x width, 2 mm clearance per side
+TRAY_BEYOND_POCKET = (0.03, 0.02)  # m: the tray plate is the pocket plus this along x and across
 # Per side, 45 deg ramps rising from the pocket floor at the pocket edge to this far outside it (the
 # rim's height too), as the station nests' brackets. The pockets had a 4 mm vertical wall under 6 mm
 # chamfers until the default calibration errors (joint offsets, about 1.3 mm median at the hotel) put
@@ -70,7 +71,13 @@ def add_hotel(w: UrdfWriter, wheel_radius: float) -> None:
     shapes = []
     for x, y, z in HOTEL_SLOT_XYZ:
         shapes.append(
-            ("box", (length + 0.03, width + 0.02, 0.01), (x, y, z - 0.005 - wheel_radius), (0, 0, 0), "grey")
+            (
+                "box",
+                (length + TRAY_BEYOND_POCKET[0], width + TRAY_BEYOND_POCKET[1], 0.01),
+                (x, y, z - 0.005 - wheel_radius),
+                (0, 0, 0),
+                "grey",
+            )
         )
         shapes.extend(_pocket_ramps(x, y, z - wheel_radius, length, width))
     post_top = HOTEL_SLOT_XYZ[0][2] - 0.01 - wheel_radius
@@ -92,3 +99,15 @@ def add_hotel(w: UrdfWriter, wheel_radius: float) -> None:
         w.joint(
             f"hotel_slot_{index}_joint", "fixed", "base_link", f"hotel_slot_{index}", (x, y, z - wheel_radius)
         )
+
+
+def hotel_sweep_radius() -> float:
+    """The hotel tray's farthest corner from the base centre (m), the circle it sweeps when the base
+    turns: the tray plate is the pocket plus ``TRAY_BEYOND_POCKET`` (``add_hotel``), 0.354 m."""
+    length, width = HOTEL_POCKET_SIZE
+    return max(
+        math.hypot(
+            abs(x) + (length + TRAY_BEYOND_POCKET[0]) / 2, abs(y) + (width + TRAY_BEYOND_POCKET[1]) / 2
+        )
+        for x, y, _ in HOTEL_SLOT_XYZ
+    )

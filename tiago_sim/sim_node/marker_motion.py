@@ -32,7 +32,7 @@ from labware_interfaces.msg import ErrorCodes
 from tiago_sim import transforms as tf
 from tiago_sim.lab.world import World
 from tiago_sim.perception.aruco import detect_marker
-from tiago_sim.perception.site_frames import upright_marker
+from tiago_sim.perception.site_frames import nest_in_base
 from tiago_sim.robot.kinematics import RobotKinematics
 from tiago_sim.robot.motion_library import HotelGrasp
 from tiago_sim.sim_node.action_run import ActionAbort, ActionRun
@@ -185,8 +185,9 @@ class MarkerMotionBehaviour:
         # with the height it shifts put a finger tip into the bench (seed 4029, "nothing between the
         # fingers"). Heading and position still come from the marker.
         # The marker's tilt comes from the level bench, not the image (perception.site_frames.upright_marker).
-        T_base_marker = upright_marker(sighting.T_base_marker, station.T_table_marker())
-        T_base_site = tf.levelled(T_base_marker @ T_marker_site)
+        # The height is the bench's (world file), not the sighting's (perception.site_frames.at_height).
+        height = float((station.T_world_marker() @ T_marker_site)[2, 3])
+        T_base_site = nest_in_base(sighting.T_base_marker, station.T_table_marker(), T_marker_site, height)
         releasing = goal.target == "site" and self.behaviours.holding.get(arm, False)
         if releasing:  # where the plate hangs, seen with the nest's marker: shift the tool to centre it
             T_base_site = self._centred_on_plate(run, arm, T_base_site, sighting)

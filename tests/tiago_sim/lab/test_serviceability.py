@@ -12,8 +12,15 @@ from typing import Any
 import pytest
 import yaml
 
+from tiago_sim.lab.serviceability import (
+    ALIGN_DRIVE_OVERSHOOT,
+    ALIGN_SIGHTING_ERROR,
+    WORKING_CLEARANCE,
+    bench_distance,
+)
 from tiago_sim.lab.world import WorldError, load_world
 from tiago_sim.lab.world_schema import SCHEMA_FILE
+from tiago_sim.robot.hotel_model import hotel_sweep_radius
 
 DEFAULT = yaml.safe_load((SCHEMA_FILE.parent / "default.yaml").read_text())
 
@@ -52,9 +59,40 @@ def test_a_working_pose_that_puts_the_base_inside_the_bench_is_refused(tmp_path:
     problems = refusal(tmp_path, close)
     assert any(
         "stations[0]: 'station_a': the base at the working pose" in line
-        and "from bench 'station_a'; the hotel tray's turning circle needs 0.350 m" in line
+        and "from bench 'station_a'; the hotel tray's turning circle and the final approach's error "
+        "needs 0.370 m"
+        in line
         for line in problems
     ), problems
+
+
+@pytest.mark.parametrize(("from_bench", "refused"), [(0.361, True), (0.371, False)])
+def test_a_working_pose_within_the_tray_s_reach_plus_the_approach_error_is_refused(
+    tmp_path: Path, from_bench: float, refused: bool
+) -> None:
+    """Random layout 92012: a working pose 0.361 m from its bench passed a check of 0.35 m (the tray
+    reaches 0.354 m) and the tray touched the bench in the final approach, the base 12 mm nearer than
+    its working pose. The clearance is the tray's corner from the hotel model plus the approach's error."""
+    assert WORKING_CLEARANCE == pytest.approx(
+        hotel_sweep_radius() + ALIGN_SIGHTING_ERROR + ALIGN_DRIVE_OVERSHOOT, abs=1e-12
+    )
+    assert hotel_sweep_radius() == pytest.approx(0.354, abs=0.0005)
+    station = load_world(SCHEMA_FILE.parent / "default.yaml").station("station_a")
+    working = station.aligned_pose()
+    now = bench_distance(station, working.x, working.y)
+
+    def nearer(data: dict[str, Any]) -> None:
+        data["stations"][0]["poi"]["work_standoff"] = round(station.work_standoff - (now - from_bench), 4)
+
+    if refused:
+        problems = refusal(tmp_path, nearer)
+        assert any(f"is {from_bench:.3f} m from bench 'station_a'" in line for line in problems), problems
+    else:
+        data = copy.deepcopy(DEFAULT)
+        nearer(data)
+        path = tmp_path / "lab.yaml"
+        path.write_text(yaml.safe_dump(data, sort_keys=False))
+        load_world(path)
 
 
 def test_stations_too_close_for_the_hotel_tray_to_turn_are_refused(tmp_path: Path) -> None:
@@ -65,7 +103,7 @@ def test_stations_too_close_for_the_hotel_tray_to_turn_are_refused(tmp_path: Pat
     problems = refusal(tmp_path, neighbour)
     turning = [line for line in problems if "turning circle" in line and "stations[0]" in line]
     assert turning and "POI station_a_work" in turning[0] and "bench 'station_b'" in turning[0], problems
-    assert "needs 0.400 m" in turning[0]
+    assert "the navigation error needs 0.404 m" in turning[0]
 
 
 def test_a_marker_the_head_camera_cannot_see_from_the_poi_is_refused(tmp_path: Path) -> None:

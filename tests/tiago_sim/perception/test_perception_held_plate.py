@@ -136,3 +136,22 @@ def test_no_shift_once_the_head_has_turned_but_one_while_it_settles(pan_then: fl
         GRASP_HEIGHT,
     )
     assert (shift is not None) == measured
+
+
+@pytest.mark.parametrize("tool_off", [-0.012, -0.009, 0.009, 0.012])
+def test_the_pads_are_left_out_where_the_camera_sees_them_not_only_where_the_arm_says(tool_off: float):
+    """Random layout 99012: the arm's joint readings put the tool 7 mm along the plate from where the
+    camera saw the pads (calibration errors of camera and arm); the pads' outer faces were taken for
+    the plate's long sides (95 mm wide against 85.5), the place went unmeasured and the plate landed on
+    a lead-in's rim (the rendered pads here show from 9 mm). The plate is still found, its centre
+    within a millimetre."""
+    plate_xy = (0.002, -0.001)
+    depth, T_world_optical = _render(plate_xy, (0.0, 0.0))  # the pads about (0, 0) in the image
+    points = site_points(depth, CameraIntrinsics(), tf.invert(T_WORLD_SITE) @ T_world_optical)
+    tool = np.array([tool_off, 0.0, APPROACH + GRASP_HEIGHT])  # where the arm's readings put it
+    sighting = locate_held_plate(
+        points, tool, GRASP_HEIGHT, PLATE.length, PLATE.width, PLATE.height, PAD_WIDTH
+    )
+    assert sighting is not None
+    assert abs(sighting.x - plate_xy[0]) < 0.001
+    assert abs(sighting.y - plate_xy[1]) < 0.001

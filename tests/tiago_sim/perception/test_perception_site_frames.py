@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from tiago_sim.perception.aruco import detect_marker
 from tiago_sim.perception.camera import CameraIntrinsics, optical_frame_looking_at, render_rgbd
 from tiago_sim.perception.marker_asset import marker_visual
-from tiago_sim.perception.site_frames import levelled, site_frames, upright_marker
+from tiago_sim.perception.site_frames import levelled, nest_in_base, site_frames, upright_marker
 from tiago_sim.transforms import from_xyz_rpy, invert, rotation_angle, yaw_of
 
 angles = st.floats(-np.pi, np.pi, allow_nan=False)
@@ -124,3 +124,29 @@ def test_the_raw_marker_tilt_moves_the_nest_by_its_lever():
     assert (upright_marker(seen, MARKER_UPRIGHT) @ SITE_IN_MARKER)[2, 3] == pytest.approx(
         true_height, abs=1e-9
     )
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    bench_yaw=angles,
+    seen_high_mm=st.floats(-6.0, 6.0),
+    glued_up_mm=st.floats(-3.0, 3.0),
+    tilt_deg=st.floats(-0.5, 0.5),
+)
+def test_the_nest_height_is_the_bench_s_whatever_height_the_marker_is_seen_at(
+    bench_yaw, seen_high_mm, glued_up_mm, tilt_deg
+):
+    """Default-lab seed 96195: the marker seen 3.6 mm high (camera calibration) and glued 2.7 mm up its
+    stand put the nest 6.3 mm high, and the pads closed over the plate. The height is the bench's; the
+    floor position and heading stay the sighting's."""
+    T_base_table = from_xyz_rpy((0.9, -0.2, 0.75), (0.0, 0.0, bench_yaw))
+    true_site = T_base_table @ MARKER_UPRIGHT @ SITE_IN_MARKER
+    glued = MARKER_UPRIGHT @ from_xyz_rpy((0.0, glued_up_mm / 1000, 0.0), (0.0, 0.0, 0.0))  # y: up the stand
+    seen = from_xyz_rpy((0.0, 0.0, seen_high_mm / 1000), (0.0, 0.0, 0.0)) @ T_base_table @ glued
+    seen = seen @ from_xyz_rpy((0.0, 0.0, 0.0), np.radians((tilt_deg, 0.0, 0.0)))
+    site = nest_in_base(seen, MARKER_UPRIGHT, SITE_IN_MARKER, true_site[2, 3])
+    assert site[2, 3] == pytest.approx(true_site[2, 3], abs=1e-9)
+    np.testing.assert_allclose(site[:3, 2], [0.0, 0.0, 1.0], atol=1e-12)
+    # along the floor: the sighting's position (a marker glued up its stand moves nothing sideways)
+    np.testing.assert_allclose(site[:2, 3], true_site[:2, 3], atol=2e-4)
+    assert abs(np.angle(np.exp(1j * (yaw_of(site) - yaw_of(true_site))))) < 1e-6
