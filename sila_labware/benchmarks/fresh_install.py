@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import re
 import subprocess
 import sys
@@ -22,9 +23,29 @@ REPOSITORY = Path(__file__).resolve().parents[2]
 BUILD_REPORT = re.compile(r"labware_interfaces built into the wheel in ([0-9.]+) s")
 
 
+INHERITED_SETUP = (
+    "LD_LIBRARY_PATH",
+    "_ROS_WHEELS_BOOTSTRAP_COMPLETE",
+    "VIRTUAL_ENV",
+    "PYTHONPATH",
+    "PYTHONHOME",
+)
+"""What a Python with the ROS wheels sets for itself and its children: the library path into its own
+venv, and the flag that tells the ROS wheels' start-up hook it already ran. A new venv run with
+them loads the running venv's ROS libraries (on Python 3.13 its demo then failed: "Could not
+import 'rosidl_typesupport_c' for package 'rcl_interfaces'"), so every stage runs without them,
+as from a user's fresh shell."""
+
+
+def fresh_shell_environment(environment: dict[str, str]) -> dict[str, str]:
+    """`environment` less what this interpreter's own set-up put there (INHERITED_SETUP)."""
+    return {name: value for name, value in environment.items() if name not in INHERITED_SETUP}
+
+
 def _timed(command: list[str], **options) -> tuple[float, subprocess.CompletedProcess]:
     started = time.monotonic()
-    done = subprocess.run(command, capture_output=True, text=True, check=False, **options)
+    environment = fresh_shell_environment(dict(os.environ))
+    done = subprocess.run(command, capture_output=True, text=True, check=False, env=environment, **options)
     return time.monotonic() - started, done
 
 
