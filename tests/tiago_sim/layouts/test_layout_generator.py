@@ -15,7 +15,14 @@ from hypothesis import strategies as st
 from labware_model.holders import Nest
 from tiago_sim.lab.serviceability import bench_distance
 from tiago_sim.lab.world import load_world
-from tiago_sim.layouts.generator import DOCK_BOX, DOCK_BOX_BEHIND, dock_box, generate_layout, layout_world
+from tiago_sim.layouts.generator import (
+    DOCK_BOX,
+    DOCK_BOX_BEHIND,
+    dock_box,
+    generate_layout,
+    layout_world,
+    route_problems,
+)
 from tiago_sim.layouts.layout_file import layout_yaml
 from tiago_sim.layouts.station_draw import LABWARE_TYPES, RANGES
 
@@ -41,6 +48,7 @@ def test_every_generated_layout_loads_and_stays_in_its_ranges(tmp_path: Path, se
     assert any(isinstance(h, Nest) and h.station == source.name for h in holders)
     assert any(nest not in holders for nest in destination.nests())
     assert set(world.labware_types) == set(LABWARE_TYPES)
+    assert route_problems(world) == []  # a plan between every two POIs, and out of every working pose
 
 
 def test_the_same_seed_gives_the_same_layout_and_another_seed_another() -> None:
