@@ -301,12 +301,7 @@ class Sequencer:
         for field_name, value in step.goal.items():
             setattr(goal, field_name, value)
 
-        def on_feedback(message: Any) -> None:
-            run.step_progress = float(message.feedback.progress)
-            run.step_remaining_s = float(message.feedback.remaining_time_s)
-            if message.feedback.phase:
-                run.phase = f"{step.phase}: {message.feedback.phase}"
-
+        on_feedback, silence = run.follow_sub_goal(step.phase)
         log.info("%s: %s", which, step.describe())
         sent = client.send_goal_async(goal, feedback_callback=on_feedback)
         if not await within(self.node, sent, float(self.param("server_wait_s"))):
@@ -323,6 +318,7 @@ class Sequencer:
             response = await self._result_within_step_timeout(sub_goal, step, which)
         finally:
             run.sub_goal = None
+            silence()
         sub_result = response.result
         if response.status == GoalStatus.STATUS_CANCELED or sub_result.error_code == ErrorCodes.CANCELED:
             raise StepFailed(ErrorCodes.CANCELED, f"canceled during {step.describe()}: {sub_result.message}")

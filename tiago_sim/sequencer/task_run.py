@@ -51,6 +51,7 @@ class TaskRun:
         self.step_remaining_s: float | None = None
         self.phase = "starting"
         self.sub_goal: Any = None  # ClientGoalHandle of the running sub-action
+        self.reported = 0.0  # the highest progress sent: a client never sees it go back
 
     @classmethod
     def for_plan(
@@ -71,6 +72,21 @@ class TaskRun:
     def index(self, value: int) -> None:
         self._index = value
         self.step_started = self.clock() if self.clock is not None else 0.0
+
+    def follow_sub_goal(self, step_phase: str) -> tuple[Callable[[Any], None], Callable[[], None]]:
+        """The feedback callback of one step's sub-goal, and the switch that silences it once its
+        result is in: feedback and result travel apart, and a late message must not move the next step."""
+        live = [True]
+
+        def on_feedback(message: Any) -> None:
+            if not live[0]:
+                return
+            self.step_progress = float(message.feedback.progress)
+            self.step_remaining_s = float(message.feedback.remaining_time_s)
+            if message.feedback.phase:
+                self.phase = f"{step_phase}: {message.feedback.phase}"
+
+        return on_feedback, lambda: live.__setitem__(0, False)
 
     def progress(self) -> float:
         done = sum(self.durations[: self.index])
@@ -93,7 +109,10 @@ class TaskRun:
 
     def publish(self) -> None:
         feedback = self.feedback_type()
-        feedback.progress = float(self.progress())
+        # Why a floor: a step that runs longer than estimated, or a sub-goal whose own progress
+        # drops (a drive that plans a longer way round), would otherwise move the bar backwards.
+        self.reported = max(self.reported, self.progress())
+        feedback.progress = float(self.reported)
         feedback.phase = self.phase
         feedback.remaining_time_s = float(self.remaining_s())
         self.goal_handle.publish_feedback(feedback)

@@ -73,6 +73,7 @@ class ActionRun:
         self.phase = "starting"
         self.remaining_s = 0.0
         self._last_feedback = 0.0
+        self._published_progress = 0.0
 
     def canceled(self) -> bool:
         return bool(self.goal_handle.is_cancel_requested)
@@ -89,7 +90,9 @@ class ActionRun:
             return
         self._last_feedback = now
         message = self.feedback_type()
-        message.progress = float(min(max(progress, 0.0), 1.0))
+        # never below what was sent: a drive planning a longer way round must not move the bar back
+        self._published_progress = max(self._published_progress, min(max(progress, 0.0), 1.0))
+        message.progress = float(self._published_progress)
         message.phase = phase
         message.remaining_time_s = float(max(remaining_s, 0.0))
         try:

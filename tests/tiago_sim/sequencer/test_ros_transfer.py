@@ -4,7 +4,8 @@ Ground truth (/check_placement) judges where the plate ends up; everything else 
 the same actions and topics a real robot would offer. The tests share one pair of processes
 and run in file order (the plate moves on from test to test). The fault tests inject through the
 sim node's parameters mid-task (waiting for the phase in the task's feedback) and end with the
-plate put back in station_a:1, where the next test expects it.
+plate put back in station_a:1, where the next test expects it; a test that leaves it anywhere
+else (it failed half-way) is followed by a lab reset, so its failure does not spread to the next.
 """
 
 from __future__ import annotations
@@ -22,9 +23,11 @@ from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
 from rcl_interfaces.srv import SetParameters
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import CameraInfo, Image, JointState, LaserScan
+from std_srvs.srv import Trigger
 
 from tests.helpers.ros_processes import RosCaller, running
 from tests.helpers.sim_parameters import parameter_request
+from tiago_sim.sim_node.lab_reset import RESET_SERVICE
 from tiago_sim.sim_node.publishers import CAMERA_IMAGE_TOPIC, CAMERA_INFO_TOPIC
 
 PLATE = "plate_001"
@@ -54,6 +57,27 @@ def robot(tmp_path_factory: pytest.TempPathFactory) -> Iterator[RosCaller]:
     for process, name in ((sim, "sim_node"), (sequencer, "sequencer")):
         assert process.returncode == 0, f"{name} did not exit cleanly on SIGTERM: {process.returncode}"
         assert "Traceback" not in (logs / f"{name}.log").read_text(), f"{name} logged a traceback"
+
+
+@pytest.fixture(autouse=True)
+def plate_back_in_station_a(robot: RosCaller) -> Iterator[None]:
+    """After each test the plate is in station_a:1 with the hotel empty; if a test left it anywhere
+    else, the lab is reset (once the goal it may have left running has ended)."""
+    yield
+    if placement(robot).location == "station:station_a:1":
+        return
+
+    def reset_done() -> bool:  # refused while a goal the failed test left runs: ask again later
+        if robot.call_service(Trigger, RESET_SERVICE, Trigger.Request()).success:
+            return True
+        robot.spin_for(1.0)
+        return False
+
+    robot.wait_for(reset_done, TASK_TIMEOUT_S, "a lab reset")
+    in_a = "station:station_a:1"
+    robot.wait_for(lambda: placement(robot).location == in_a, 30.0, "the plate in station_a:1")
+    hotel_empty = lambda: not any(slot.labware_id for slot in robot.latest["/robot_state"].hotel)  # noqa: E731
+    robot.wait_for(hotel_empty, 30.0, "an empty hotel")
 
 
 def task_goal(kind: type, station: str, sub_position: int, slot: int) -> object:
