@@ -98,9 +98,10 @@ class RosCaller:
                 raise TimeoutError(f"timed out waiting for {what}")
             self.executor.spin_once(timeout_sec=0.05)
 
-    def subscribe(self, message_type: Any, topic: str) -> None:
+    def subscribe(self, message_type: Any, topic: str) -> Any:
+        """Keep the latest message of `topic` in `latest`; returns the subscription (to destroy)."""
         qos = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
-        self.node.create_subscription(
+        return self.node.create_subscription(
             message_type, topic, lambda msg: self.latest.__setitem__(topic, msg), qos
         )
 

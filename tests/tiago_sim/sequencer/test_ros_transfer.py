@@ -140,11 +140,17 @@ def test_robot_starts_docked_with_an_empty_hotel(robot: RosCaller) -> None:
 
 
 def test_head_camera_is_published_when_subscribed(robot: RosCaller) -> None:
-    robot.subscribe(Image, CAMERA_IMAGE_TOPIC)
-    robot.subscribe(CameraInfo, CAMERA_INFO_TOPIC)
-    robot.wait_for(
-        lambda: CAMERA_IMAGE_TOPIC in robot.latest and CAMERA_INFO_TOPIC in robot.latest, 20.0, "camera"
-    )
+    subscriptions = [
+        robot.subscribe(Image, CAMERA_IMAGE_TOPIC),
+        robot.subscribe(CameraInfo, CAMERA_INFO_TOPIC),
+    ]
+    try:
+        robot.wait_for(
+            lambda: CAMERA_IMAGE_TOPIC in robot.latest and CAMERA_INFO_TOPIC in robot.latest, 20.0, "camera"
+        )
+    finally:  # the sim node renders only while someone subscribes: the later tests need not pay for it
+        for subscription in subscriptions:
+            robot.node.destroy_subscription(subscription)
     image, info = robot.latest[CAMERA_IMAGE_TOPIC], robot.latest[CAMERA_INFO_TOPIC]
     assert (image.width, image.height, image.encoding) == (640, 480, "rgb8")
     assert len(image.data) == 640 * 480 * 3 and len(set(bytes(image.data[::997]))) > 10  # not blank
@@ -225,6 +231,10 @@ def subscribe_latched(robot: RosCaller, message_type: type, topic: str) -> None:
     robot.node.create_subscription(message_type, topic, lambda msg: robot.latest.__setitem__(topic, msg), qos)
 
 
+def seconds(stamp: object) -> float:
+    return stamp.sec + stamp.nanosec * 1e-9
+
+
 def test_laser_scan_and_localised_pose_are_published_with_their_frames(robot: RosCaller) -> None:
     robot.subscribe(LaserScan, "/scan")
     subscribe_latched(robot, PoseWithCovarianceStamped, "/amcl_pose")
@@ -238,6 +248,11 @@ def test_laser_scan_and_localised_pose_are_published_with_their_frames(robot: Ro
     assert len(seen) > 50 and min(seen) >= scan.range_min  # the benches, never the robot itself
     pose = robot.latest["/amcl_pose"]
     assert pose.header.frame_id == "map"
+    robot.wait_for(  # a state report as new as the pose: one still queued from the last drive may be older
+        lambda: seconds(robot.latest["/robot_state"].stamp) >= seconds(pose.header.stamp),
+        10.0,
+        "a robot state as new as the localised pose",
+    )
     believed = robot.latest["/robot_state"].base_pose  # the base stands: the same pose, both ways
     assert (pose.pose.pose.position.x, pose.pose.pose.position.y) == pytest.approx(
         (believed.x, believed.y), abs=0.01
