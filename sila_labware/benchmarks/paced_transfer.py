@@ -1,6 +1,7 @@
 """One transfer at a set pace, through the Python SiLA client: is a paced robot's timing honest?
 
     python -m sila_labware.benchmarks.paced_transfer [--pace 1.0] [--world FILE] [--json] [--log-dir DIR]
+        [--port-base P]   (runs side by side need their own port bases)
 
 Why: at `--pace 1` a client should see a real robot's timing. Two figures say whether it does:
 - the transfer's wall time against its simulated time (the robot's /robot_state clock): their
@@ -94,12 +95,14 @@ class ProgressSamples:
         return RemainingAtHalfway(step, record.progress, record.remaining_s, ends[0] - wall)
 
 
-def run(world: Path, pace: float, scratch: Path, log_dir: Path | None = None) -> PacedTransferReport:
+def run(
+    world: Path, pace: float, scratch: Path, log_dir: Path | None = None, port_base: int | None = None
+) -> PacedTransferReport:
     """Start a deployment at `pace`, move the first station's plate to the second, measure."""
     options = DeploymentOptions(
         world=world, port_base=0, ca_file=scratch / "ca.pem", discovery=False, pace=pace, log_dir=log_dir
     )
-    options.port_base = _free_port_base()
+    options.port_base = _free_port_base() if port_base is None else port_base
     deployment = Deployment(options)
     deployment.start()
     try:
@@ -142,10 +145,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--world", type=Path, default=DEFAULT_WORLD)
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.add_argument("--log-dir", type=Path, default=None, help="keep the robot side's logs here")
+    parser.add_argument(
+        "--port-base", type=int, default=None, help="SiLA ports from here (default: the first four free)"
+    )
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.WARNING)
     with tempfile.TemporaryDirectory(prefix="sila-labware-paced-") as scratch:
-        report = run(args.world, args.pace, Path(scratch), args.log_dir)
+        report = run(args.world, args.pace, Path(scratch), args.log_dir, args.port_base)
     if args.json:
         sys.stdout.write(json.dumps(report.as_json_object()) + "\n")
         return 0
