@@ -35,9 +35,9 @@ def durations_by_kind(lines: Iterable[str]) -> dict[str, list[float]]:
 
 
 def table_rows(kinds: dict[str, list[float]]) -> list[str]:
-    """`estimates_s` lines: the kind as a parameter name and its mean, to a tenth of a second."""
+    """`estimates_s` lines: the kind as a parameter name and its mean, to a hundredth of a second."""
     return [
-        f"  {kind.replace(':', KIND_SEPARATOR_IN_PARAMETERS)}: {sum(values) / len(values):.1f}"
+        f"  {kind.replace(':', KIND_SEPARATOR_IN_PARAMETERS)}: {sum(values) / len(values):.2f}"
         f"  # n={len(values)}, {min(values):.2f}..{max(values):.2f}"
         for kind, values in kinds.items()
     ]

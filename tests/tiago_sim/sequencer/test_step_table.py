@@ -23,8 +23,8 @@ def test_each_task_kind_gets_its_mean_and_drives_are_left_to_the_action_row(tmp_
     (tmp_path / "b.log").write_text(LOG_B)
     assert main([str(tmp_path / "a.log"), str(tmp_path / "b.log")]) == 0
     rows = capsys.readouterr().out.splitlines()
-    assert rows[0].startswith("  GetLabware.marker_motion.work_pose.final_approach: 2.9  # n=2, 2.70..3.10")
-    assert rows[1].startswith("  GetLabware.gripper.open.opening: 0.6  # n=1")
+    assert rows[0].startswith("  GetLabware.marker_motion.work_pose.final_approach: 2.90  # n=2, 2.70..3.10")
+    assert rows[1].startswith("  GetLabware.gripper.open.opening: 0.60  # n=1")
     assert len(rows) == 2, "a drive's duration belongs to its lab: no row"
 
 
