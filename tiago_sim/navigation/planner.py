@@ -138,6 +138,10 @@ class GlobalPlanner:
         default: everything on the static map, as for obstacles of unknown height)."""
         self.static_map = static_map
         self.arms_map = static_map if arms_map is None else arms_map
+        # across a segment, every half cell out to the arms' reach on either side
+        self._arm_offsets = np.arange(
+            -ARMS_HALF_WIDTH_M, ARMS_HALF_WIDTH_M + 1e-9, self.arms_map.resolution / 2
+        )
         clearance = static_map.clearance_m()
         self.clearance = clearance
         self.inflated = static_map.inflated(INFLATION_RADIUS_M)
@@ -306,8 +310,7 @@ class GlobalPlanner:
     def _arms_clear(self, point: tuple[float, float], direction: float) -> bool:
         """Nothing as high as the folded arms beside `point` within their reach, across a straight
         segment driven along `direction` (the line through the point at right angles to it)."""
-        grid = self.arms_map
-        offsets = np.arange(-ARMS_HALF_WIDTH_M, ARMS_HALF_WIDTH_M + 1e-9, grid.resolution / 2)
+        grid, offsets = self.arms_map, self._arm_offsets
         return _points_free(
             grid, point[0] - math.sin(direction) * offsets, point[1] + math.cos(direction) * offsets
         )

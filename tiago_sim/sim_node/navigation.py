@@ -28,7 +28,7 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 from tiago_sim.lab.world import World
 from tiago_sim.navigation.blockage import UnmappedObstacles, marks, still_there
-from tiago_sim.navigation.occupancy_map import OccupancyMap, build_map
+from tiago_sim.navigation.occupancy_map import OccupancyMap
 from tiago_sim.navigation.planner import GlobalPlanner, Plan, PlanningError, world_planner
 from tiago_sim.physics.guarded_path import PATH_BLOCKED, scan_in_map
 from tiago_sim.sim_node.action_run import ActionAbort, ActionRun
@@ -88,8 +88,8 @@ class Navigation:
     """The planner on the believed map, its topics, and the navigate drive."""
 
     def __init__(self, node: Node, world: World) -> None:
-        self.static_map = build_map(world)
         self.planner = world_planner(world)
+        self.static_map = self.planner.static_map
         latched = QoSProfile(
             depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
         )
