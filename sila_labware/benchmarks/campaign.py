@@ -5,10 +5,9 @@ drift, placements off by millimetres). This measures ours the same way, through 
 servers and the same standard command order as `sila-labware demo` (demo.run_demo).
 
 One trial = a fresh deployment (sim node built from the trial seed's disturbed world, sequencer,
-bridge, SiLA servers), the demo transfer, then stop. A fresh start costs about 7 s against about
-17 s for the transfer (measured on 2 cores) and guarantees independent trials; resetting a running
-world in place would save that but has to put back every plate, joint and odometry state. Trial
-k of a campaign with seed S uses disturbance seed S + k, so `--replay S+k` runs it again alone: with
+bridge, SiLA servers), the demo transfer, then stop: a fresh start (1.3 to 1.8 s against 5 s for
+the transfer) keeps trials independent; a reset would also have to redraw what the robot believes.
+Trial k of a campaign with seed S uses disturbance seed S + k, so `--replay S+k` runs it again alone: with
 the same disturbances, not as the same run (the robot side's clock also runs, at 1x wall time,
 while the robot software computes, so a replay's timing and contacts can differ; a failure that
 does not come back on replay is not thereby explained).
@@ -89,6 +88,7 @@ LEVEL_FLAGS = (
         "--joint-offset-deg", "joint_offset_rad", math.pi / 180, 0.1, "encoder zero error per arm/head joint"
     ),
     LevelFlag("--id-read-failure-pct", "id_read_failure", 1e-2, 0.1, "chance that a barcode read fails"),
+    LevelFlag("--bench-height-error-mm", "bench_height_m", 1e-3, 1.0, "bench top higher than the world file"),
 )
 
 

@@ -77,6 +77,9 @@ class DisturbanceLevels:
     - joint offsets 0.1 deg per arm and head joint: encoder zeros after a factory calibration.
     - identity reads 0.1 % failed: fixed-mount barcode readers on clean labels read 99.9 % or
       better on the first try; worn or skewed labels read worse.
+    - bench height 1 mm: the top's height as an integrator measures it with a tape for the world
+      file. The robot takes a nest's height from the file's bench (not from the marker, whose
+      sighting is a few millimetres off in height), so this error goes straight into the grasp.
     """
 
     navigation_xy_m: float = 0.03
@@ -97,6 +100,7 @@ class DisturbanceLevels:
     camera_mount_rpy_rad: float = math.radians(0.1)
     joint_offset_rad: float = math.radians(0.1)
     id_read_failure: float = 0.001  # probability that one read of a plate's label fails
+    bench_height_m: float = 0.001  # the bench top's true height less the world file's
 
     def scaled(self, factor: float) -> DisturbanceLevels:
         """Every level times `factor` (0 gives an undisturbed world)."""
@@ -149,6 +153,7 @@ class TrialDisturbance:
     camera_mount: tuple[float, ...] = (0.0,) * 6  # x, y, z (m), roll, pitch, yaw (rad) in the optical frame
     joint_offsets: dict[str, float] = field(default_factory=dict)  # joint -> reading minus truth (rad)
     depth_bias_m: float = 0.0  # at 1 m, growing with distance squared
+    bench_height: dict[str, float] = field(default_factory=dict)  # station -> true less file height (m)
 
     def T_camera_mount_error(self) -> np.ndarray:
         """The true optical frame in the modelled one."""
@@ -173,6 +178,7 @@ class TrialDisturbance:
             + [round(math.degrees(v), 3) for v in self.camera_mount[3:]],
             "joint_offsets_deg": {k: round(math.degrees(v), 3) for k, v in self.joint_offsets.items()},
             "depth_bias_mm_at_1m": round(1000 * self.depth_bias_m, 2),
+            "bench_height_mm": {k: round(1000 * v, 2) for k, v in self.bench_height.items()},
         }
 
 
@@ -209,8 +215,10 @@ def draw(world: World, seed: int, levels: DisturbanceLevels) -> TrialDisturbance
     )
     offsets = {name: _clipped_normal(calibration, levels.joint_offset_rad) for name in CALIBRATED_JOINTS}
     depth_bias = _clipped_normal(calibration, levels.depth_bias_m)
+    measured = np.random.default_rng([seed, 0xBE4C])  # a stream of its own, as the calibration's
+    heights = {s.name: _clipped_normal(measured, levels.bench_height_m) for s in world.stations}
     return TrialDisturbance(
-        seed, levels, navigation, station, marker, nest, mass, friction, mount, offsets, depth_bias
+        seed, levels, navigation, station, marker, nest, mass, friction, mount, offsets, depth_bias, heights
     )
 
 
@@ -240,9 +248,11 @@ def _true_station(station: Station, disturbance: TrialDisturbance) -> Station:
     T_marker_site = tf.invert(marker_error.matrix()) @ station.T_marker_site(1) @ nest_error.matrix()
     marker_xyz, marker_rpy = _xyz_rpy(T_table_marker)
     site_xyz, site_rpy = _xyz_rpy(T_marker_site)
+    depth, width, height = station.table_size  # marker and nests stand on the top: they rise with it
     return dataclasses.replace(
         station,
         table_pose=table_pose,
+        table_size=(depth, width, height + disturbance.bench_height.get(station.name, 0.0)),
         marker_xyz=marker_xyz,
         marker_rpy=marker_rpy,
         site_xyz=site_xyz,

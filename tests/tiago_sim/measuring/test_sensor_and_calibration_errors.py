@@ -179,3 +179,29 @@ def test_the_calibration_draws_leave_every_earlier_draw_of_a_seed_as_it_was():
     assert all(v == 0 for v in without.joint_offsets.values())
     limit = disturbances.CLIP_SIGMAS * DEFAULT.joint_offset_rad
     assert all(abs(v) <= limit for v in with_calibration.joint_offsets.values())
+
+
+def test_a_bench_height_error_raises_the_true_bench_with_its_marker_and_nests_and_nothing_else():
+    """The robot believes the file's height (it takes the nest's height from it); the simulation
+    builds the bench, its marker and its nests that much higher. Its draws have a stream of their
+    own, so every earlier draw of a seed stays as it was."""
+    world = load_world()
+    drawn = disturbances.draw(world, 123, DEFAULT)
+    without = disturbances.draw(world, 123, dataclasses.replace(DEFAULT, bench_height_m=0.0))
+    for table in ("navigation", "station", "marker", "nest", "joint_offsets", "camera_mount", "depth_bias_m"):
+        assert getattr(drawn, table) == getattr(without, table), table
+    assert set(drawn.bench_height) == {s.name for s in world.stations}
+    assert all(
+        0 < abs(v) <= disturbances.CLIP_SIGMAS * DEFAULT.bench_height_m for v in drawn.bench_height.values()
+    )
+    assert all(v == 0 for v in without.bench_height.values())
+    raised = disturbances.true_world(world, drawn)
+    level = disturbances.true_world(world, without)
+    for station in world.stations:
+        rise = drawn.bench_height[station.name]
+        true, flat = raised.station(station.name), level.station(station.name)
+        assert true.table_size[2] == pytest.approx(station.table_size[2] + rise)
+        assert true.T_world_marker()[2, 3] - flat.T_world_marker()[2, 3] == pytest.approx(rise)
+        assert true.T_world_site(1)[2, 3] - flat.T_world_site(1)[2, 3] == pytest.approx(rise)
+        assert np.allclose(true.T_world_site(1)[:2, 3], flat.T_world_site(1)[:2, 3])
+    assert "bench_height_mm" in drawn.summary()
