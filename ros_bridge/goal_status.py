@@ -39,7 +39,7 @@ Callbacks: `add_callback(fn)` calls `fn(goal)` exactly once, on the thread that 
 goal has already finished. Keep them short; an exception in one is logged, never propagated.
 
 Progress: `progress` is the robot side's latest feedback; its fraction done (0..1) never goes down
-(`ros_bridge.progress.MonotonicProgress`) and becomes 1 ("done") when the goal succeeds. Progress
+(`labware_model.progress.MonotonicProgress`) and becomes 1 ("done") when the goal succeeds. Progress
 listeners are called on every feedback, on the thread that delivers it (the ROS thread for
 `ActionCaller`); feedback that arrives after the end is dropped.
 

@@ -1,6 +1,6 @@
 """Progress of a goal and of a command made of goals: a fraction done that never goes down.
 
-"Progress never goes down" is written once, in `MonotonicProgress`: a goal's feedback
+"Progress never goes down" is written once, in `labware_model.progress.MonotonicProgress`: a goal's feedback
 (`ActionGoal`) and a command's report (`CommandProgress`, which maps each of its goals into a
 share of 0..1) both pass their numbers through one. A robot side that re-plans may estimate less
 than before; callers (a SiLA client's progress bar, Bluesky's ProgressBar) must never see a bar
@@ -12,10 +12,11 @@ a command's own reports come from the SiLA handler thread that runs it.
 
 from __future__ import annotations
 
-import math
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass
+
+from labware_model.progress import MonotonicProgress
 
 ProgressReport = Callable[[float, float | None], None]
 """Called with (fraction done 0..1, estimated remaining time in wall seconds, or None where there
@@ -31,28 +32,6 @@ class GoalProgress:
     phase: str = "pending"
     remaining_time_s: float = 0.0
     feedback_count: int = 0
-
-
-class MonotonicProgress:
-    """A fraction done in 0..1 that only rises: the one place the rule is written."""
-
-    def __init__(self, fraction: float = 0.0) -> None:
-        self._lock = threading.Lock()
-        self._fraction = 0.0
-        self.advance(fraction)
-
-    @property
-    def fraction(self) -> float:
-        with self._lock:
-            return self._fraction
-
-    def advance(self, estimate: float) -> float:
-        """Take a new estimate; return the fraction to show: clamped to 0..1 and never below the
-        highest shown so far. A NaN or infinite estimate changes nothing."""
-        with self._lock:
-            if math.isfinite(estimate):
-                self._fraction = max(self._fraction, min(1.0, max(0.0, estimate)))
-            return self._fraction
 
 
 class CommandProgress:

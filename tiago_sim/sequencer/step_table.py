@@ -48,10 +48,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not paths:
         sys.stderr.write("usage: python -m tiago_sim.sequencer.step_table LOG [LOG ...]\n")
         return 2
-    kinds: dict[str, list[float]] = {}
-    for path in paths:
-        for kind, values in durations_by_kind(path.read_text().splitlines()).items():
-            kinds.setdefault(kind, []).extend(values)
+    kinds = durations_by_kind(line for path in paths for line in path.read_text().splitlines())
     sys.stdout.write("\n".join(table_rows(kinds)) + "\n")
     return 0
 

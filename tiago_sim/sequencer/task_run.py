@@ -10,6 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from labware_model.progress import MonotonicProgress
 from tiago_sim.sequencer.plans import Step
 from tiago_sim.sequencer.step_durations import StepDurations
 
@@ -51,7 +52,7 @@ class TaskRun:
         self.step_remaining_s: float | None = None
         self.phase = "starting"
         self.sub_goal: Any = None  # ClientGoalHandle of the running sub-action
-        self.reported = 0.0  # the highest progress sent: a client never sees it go back
+        self.reported = MonotonicProgress()  # what clients are sent: a step running long never pulls it back
 
     @classmethod
     def for_plan(
@@ -109,10 +110,7 @@ class TaskRun:
 
     def publish(self) -> None:
         feedback = self.feedback_type()
-        # Why a floor: a step that runs longer than estimated, or a sub-goal whose own progress
-        # drops (a drive that plans a longer way round), would otherwise move the bar backwards.
-        self.reported = max(self.reported, self.progress())
-        feedback.progress = float(self.reported)
+        feedback.progress = float(self.reported.advance(self.progress()))
         feedback.phase = self.phase
         feedback.remaining_time_s = float(self.remaining_s())
         self.goal_handle.publish_feedback(feedback)

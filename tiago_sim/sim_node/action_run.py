@@ -17,6 +17,7 @@ from typing import Any
 
 from labware_interfaces.msg import ErrorCodes
 
+from labware_model.progress import MonotonicProgress
 from tiago_sim.sim_node.sim_thread import SimThread
 
 log = logging.getLogger(__name__)
@@ -73,7 +74,7 @@ class ActionRun:
         self.phase = "starting"
         self.remaining_s = 0.0
         self._last_feedback = 0.0
-        self._published_progress = 0.0
+        self._published = MonotonicProgress()  # a drive planning a longer way round must not pull it back
 
     def canceled(self) -> bool:
         return bool(self.goal_handle.is_cancel_requested)
@@ -90,9 +91,7 @@ class ActionRun:
             return
         self._last_feedback = now
         message = self.feedback_type()
-        # never below what was sent: a drive planning a longer way round must not move the bar back
-        self._published_progress = max(self._published_progress, min(max(progress, 0.0), 1.0))
-        message.progress = float(self._published_progress)
+        message.progress = float(self._published.advance(progress))
         message.phase = phase
         message.remaining_time_s = float(max(remaining_s, 0.0))
         try:
