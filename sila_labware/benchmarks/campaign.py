@@ -149,18 +149,17 @@ class CampaignOptions:
 
 def trial_stack(options: CampaignOptions, trial_seed: int, worker: int = 0) -> DeploymentOptions:
     """The deployment of one trial: its world (the trial's random layout, or the campaign's), and the
-    worker's own SiLA ports and ROS domain (a requested domain id is shifted by the worker index)."""
+    worker's own SiLA ports and ROS domain (a requested domain id is shifted by the worker index), and
+    a robot side forked from the prewarmed server (its imports are paid once per campaign)."""
     extra = ["--disturbance-seed", str(trial_seed), "--disturbance-levels", levels_json(options.levels)]
-    world = options.stack.world
-    if options.layouts_dir is not None:
-        world = layout_path(options.layouts_dir, trial_seed)
-    domain_id = options.stack.domain_id
+    layouts, domain_id = options.layouts_dir, options.stack.domain_id
     return replace(
         options.stack,
-        world=world,
+        world=options.stack.world if layouts is None else layout_path(layouts, trial_seed),
         extra_sim_arguments=extra,
         port_base=options.stack.port_base + PORTS_PER_WORKER * worker,
         domain_id=None if domain_id is None else domain_id + worker,
+        prewarmed_robot_side=True,
     )
 
 

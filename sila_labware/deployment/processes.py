@@ -27,6 +27,8 @@ from pathlib import Path
 from types import FrameType
 from typing import IO
 
+from sila_labware.deployment.prewarmed import ForkedChild, fork_python_module
+
 logger = logging.getLogger(__name__)
 
 FASTDDS_PROFILE = Path(__file__).with_name("fastdds_profile.xml")
@@ -60,7 +62,7 @@ class ChildExited(RuntimeError):
 @dataclass
 class Child:
     name: str
-    popen: subprocess.Popen
+    popen: subprocess.Popen | ForkedChild
     log_path: Path | None
     output_file: IO[bytes] | None = None
     """The anonymous file the child writes to when there is no log directory."""
@@ -136,9 +138,13 @@ def interrupts_held() -> Iterator[None]:
 class ProcessGroup:
     """Children started together and stopped together."""
 
-    def __init__(self, environment: Mapping[str, str], log_dir: Path | None = None) -> None:
+    def __init__(
+        self, environment: Mapping[str, str], log_dir: Path | None = None, prewarmed: bool = False
+    ) -> None:
         self._environment = dict(environment)
         self._log_dir = log_dir
+        self._prewarmed = prewarmed
+        """Fork children from a process that imported them already (prewarmed.py), not spawn them."""
         self.children: list[Child] = []
 
     def start_python_module(self, name: str, module: str, arguments: Sequence[str]) -> Child:
@@ -154,13 +160,17 @@ class ProcessGroup:
             output = output_file = tempfile.TemporaryFile(prefix=f"sila-labware-{name}-")
         with interrupts_held():
             try:
-                popen = subprocess.Popen(
-                    argv,
-                    env=self._environment,
-                    stdout=output,
-                    stderr=subprocess.STDOUT,
-                    stdin=subprocess.DEVNULL,
-                    start_new_session=True,
+                popen = (
+                    fork_python_module(module, arguments, self._environment, output.fileno())
+                    if self._prewarmed
+                    else subprocess.Popen(
+                        argv,
+                        env=self._environment,
+                        stdout=output,
+                        stderr=subprocess.STDOUT,
+                        stdin=subprocess.DEVNULL,
+                        start_new_session=True,
+                    )
                 )
                 child = Child(name, popen, log_path, output_file)
                 self.children.append(child)

@@ -67,6 +67,9 @@ class DeploymentOptions:
     """Carried by every server name (see lab_name.py); empty: the world file's."""
     pace: float | None = None
     """Times real time the simulation runs at (see pacing.py); None: as fast as it can."""
+    prewarmed_robot_side: bool = False
+    """Fork the robot side from a process that imported it once (prewarmed.py): for runs that
+    start many deployments one after the other, such as a campaign's trials."""
 
 
 @dataclass(frozen=True)
@@ -118,7 +121,9 @@ class Deployment:
     def __init__(self, options: DeploymentOptions) -> None:
         self.options = options
         self.domain_id = choose_domain_id(options.domain_id)
-        self.children = ProcessGroup(ros_environment(self.domain_id), options.log_dir)
+        self.children = ProcessGroup(
+            ros_environment(self.domain_id), options.log_dir, prewarmed=options.prewarmed_robot_side
+        )
         self.runtime: RosRuntime | None = None
         self.link: RobotLink | None = None
         self.workcell: WorkcellDescription | None = None

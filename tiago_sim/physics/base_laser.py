@@ -12,8 +12,9 @@ obstacles standing on the floor; nothing mounted higher (marker stands on the be
 Idealisations (said in the README): the scan is taken at one instant (a real 15 Hz scan smears
 over 67 ms of motion); the range noise is Gaussian, independent per beam, without the datasheet's
 +-60 mm systematic error; every beam returns from any surface (no dark or shiny materials, no
-mixed pixels at edges); the robot's own links never appear (rays start where they leave the base's
-outline, and a beam that still hits the robot is cast on from past it).
+mixed pixels at edges); the robot's own links never appear (the rays leave the robot's collision
+group out, robot_body.ROBOT_COLLISION_GROUP: half a scan's ray casting was spent on the robot's links
+round the mount).
 Lives on the sim thread (it calls PyBullet).
 """
 
@@ -25,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 import pybullet as p
 
-from tiago_sim.physics.robot_body import RobotBody
+from tiago_sim.physics.robot_body import ROBOT_COLLISION_GROUP, RobotBody
 from tiago_sim.robot import robot_model as rm
 
 LASER_FRAME = "base_laser_link"
@@ -99,28 +100,18 @@ class BaseLaser:
         origin = np.array([x + c * spec.mount_x - s * spec.mount_y, y + s * spec.mount_x + c * spec.mount_y])
         rotation = np.array([[c, -s], [s, c]])
         directions = self._directions @ rotation.T
-        ranges = np.full(len(directions), np.inf)
-        start = self._start_distance.copy()
-        pending = np.arange(len(directions))
-        for _ in range(3):  # a beam that hits the robot (a low arm, say) is cast on from past the hit
-            if not len(pending):
-                break
-            begin = origin + directions[pending] * start[pending, None]
-            end = origin + directions[pending] * spec.range_max
-            height = np.full((len(pending), 1), spec.mount_z)
-            hits = p.rayTestBatch(
-                np.hstack([begin, height]).tolist(),
-                np.hstack([end, height]).tolist(),
-                physicsClientId=self.client,
-            )
-            found = np.array([(hit[0], hit[2]) for hit in hits], dtype=float).reshape(-1, 2)
-            distance = start[pending] + found[:, 1] * (spec.range_max - start[pending])
-            robot = found[:, 0] == self.robot.id
-            other = (found[:, 0] >= 0) & ~robot
-            ranges[pending[other]] = distance[other]
-            start[pending[robot]] = distance[robot] + 0.002
-            pending = pending[robot & (distance + 0.002 < spec.range_max)]
-        return ranges
+        begin = origin + directions * self._start_distance[:, None]
+        end = origin + directions * spec.range_max
+        height = np.full((len(directions), 1), spec.mount_z)
+        hits = p.rayTestBatch(
+            np.hstack([begin, height]),
+            np.hstack([end, height]),
+            collisionFilterMask=~ROBOT_COLLISION_GROUP,
+            physicsClientId=self.client,
+        )
+        found = np.array([(hit[0], hit[2]) for hit in hits], dtype=float).reshape(-1, 2)
+        distance = self._start_distance + found[:, 1] * (spec.range_max - self._start_distance)
+        return np.where(found[:, 0] >= 0, distance, np.inf)
 
     def read(self, sim_time: float, odometry: tuple[float, float, float]) -> LaserReading:
         """One scan, stamped with the simulated time and the odometry of the same instant."""

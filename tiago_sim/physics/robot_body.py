@@ -30,6 +30,12 @@ BASE_CONSTRAINT_FORCE = 1e5
 ARM_POSITION_GAIN = 0.3
 
 
+ROBOT_COLLISION_GROUP = 0x40
+"""The robot's links' collision group: none of Bullet's own (default 1, static 2), so a ray test
+with the mask ``~ROBOT_COLLISION_GROUP`` passes through the robot. Its mask stays "everything": the
+robot touches the lab and the plates exactly as with Bullet's default groups."""
+
+
 class RobotBody:
     """Loads the generated URDF at a floor pose and offers name-based access."""
 
@@ -82,6 +88,10 @@ class RobotBody:
             physicsClientId=client,
         )
         p.changeConstraint(self.base_constraint, maxForce=BASE_CONSTRAINT_FORCE, physicsClientId=client)
+        # every link in a collision group of its own, colliding with everything as before, so that
+        # ray tests can leave the robot out (the base laser never sees it)
+        for link in self.link_index.values():
+            p.setCollisionFilterGroupMask(self.id, link, ROBOT_COLLISION_GROUP, -1, physicsClientId=client)
         self.targets: dict[str, float] = {}  # commanded, in encoder terms
         self.encoder_offsets: dict[str, float] = {}  # joint name -> reading minus true position
         self._track_groups: dict[tuple[str, ...], tuple] = {}

@@ -188,17 +188,20 @@ def test_replay_says_it_repeats_the_disturbances_not_the_run() -> None:
 
 
 def _robot_side_pids(domain_id: str) -> list[int]:
-    """sim_node and sequencer processes of this test run's ROS domain, read from /proc."""
+    """sim_node and sequencer processes of this test run's ROS domain, read from /proc (a forked one
+    shows the fork server's command line and environment, with its own name)."""
     pids = []
     for entry in Path("/proc").iterdir():
         if not entry.name.isdigit():
             continue
         try:
             command = (entry / "cmdline").read_bytes()
+            name = (entry / "comm").read_text().strip()
             environment = (entry / "environ").read_bytes().split(b"\0")
         except OSError:
             continue
-        robot_side = b"tiago_sim.sim_node" in command or b"tiago_sim.sequencer" in command
+        robot_side = name in ("sim_node", "sequencer")  # forked from the prewarmed fork server
+        robot_side |= b"tiago_sim.sim_node" in command or b"tiago_sim.sequencer" in command
         if robot_side and f"ROS_DOMAIN_ID={domain_id}".encode() in environment:
             pids.append(int(entry.name))
     return pids
