@@ -34,6 +34,7 @@ from sila2.client import SilaClient
 from sila2.framework import SilaConnectionError
 
 from labware_model.holders import Nest
+from sila_labware.client import feature_modules
 from sila_labware.client.bounded import CALL_TIMEOUT_S, bounded
 from sila_labware.client.errors import LabwareTransferError, ParameterRejected, ServerUnreachable, translate
 from sila_labware.client.records import Address, Handover, HandoverPosition, LabwareLocation, OnboardLabware
@@ -47,6 +48,7 @@ T = TypeVar("T")
 
 def connect(address: Address, root_certs: bytes | None, insecure: bool) -> SilaClient:
     """A sila2 client of one server; ServerUnreachable if it does not answer (or refuses our TLS)."""
+    feature_modules.enable()
     host, port = address
     try:
         if insecure:
