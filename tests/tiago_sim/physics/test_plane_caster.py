@@ -66,32 +66,34 @@ def test_the_numpy_cast_matches_bullets_ray_test_but_for_beams_grazing_a_corner(
         sim.close()
 
 
-def test_a_tilted_box_in_the_plane_sends_the_scan_to_bullets_ray_test() -> None:
+def _straight_ahead_with(shape: str) -> tuple[plane_caster.CrossSections | None, float]:
+    """The default lab with one static body whose near side is 1 m straight ahead of the laser:
+    the plane's cut through the lab, and the noise-free range of the beam straight ahead."""
     sim = Simulation(load_world(), seed=3)
     try:
         laser, client = sim.laser, sim.client_id
         x, y, _ = sim.robot.base_xy_yaw()
-        face = x + laser.spec.mount_x + 1.0
-        shape = p.createCollisionShape(p.GEOM_BOX, halfExtents=[0.05, 0.5, 0.3], physicsClientId=client)
-        tilt = p.getQuaternionFromEuler([0.3, 0.0, 0.0])  # rolled about the beam: its face stays square
-        p.createMultiBody(0.0, shape, -1, [face + 0.05, y, laser.spec.mount_z], tilt, physicsClientId=client)
-        assert plane_caster.cross_sections(client, laser.spec.mount_z, {sim.robot.id}) is None
-        ahead = laser.true_ranges()[len(laser._directions) // 2]
-        assert ahead == pytest.approx(1.0, abs=2e-3)
+        face, height = x + laser.spec.mount_x + 1.0, laser.spec.mount_z
+        if shape == "tilted box":  # rolled about the beam: the face it shows the beam stays square
+            body = p.createCollisionShape(p.GEOM_BOX, halfExtents=[0.05, 0.5, 0.3], physicsClientId=client)
+            pose = ([face + 0.05, y, height], p.getQuaternionFromEuler([0.3, 0.0, 0.0]))
+        else:
+            body = p.createCollisionShape(p.GEOM_CYLINDER, radius=0.2, height=1.0, physicsClientId=client)
+            pose = ([face + 0.2, y, 0.5], [0.0, 0.0, 0.0, 1.0])
+        p.createMultiBody(0.0, body, -1, *pose, physicsClientId=client)
+        sections = plane_caster.cross_sections(client, height, {sim.robot.id})
+        return sections, float(laser.true_ranges()[len(laser._directions) // 2])
     finally:
         sim.close()
+
+
+def test_a_tilted_box_in_the_plane_sends_the_scan_to_bullets_ray_test() -> None:
+    sections, ahead = _straight_ahead_with("tilted box")
+    assert sections is None
+    assert ahead == pytest.approx(1.0, abs=2e-3)
 
 
 def test_an_upright_cylinder_is_cut_as_a_circle() -> None:
-    sim = Simulation(load_world(), seed=3)
-    try:
-        laser, client = sim.laser, sim.client_id
-        x, y, _ = sim.robot.base_xy_yaw()
-        centre = x + laser.spec.mount_x + 1.2
-        shape = p.createCollisionShape(p.GEOM_CYLINDER, radius=0.2, height=1.0, physicsClientId=client)
-        p.createMultiBody(0.0, shape, -1, [centre, y, 0.5], physicsClientId=client)
-        sections = plane_caster.cross_sections(client, laser.spec.mount_z, {sim.robot.id})
-        assert sections is not None and len(sections.circles) == 1
-        assert laser.true_ranges()[len(laser._directions) // 2] == pytest.approx(1.0, abs=1e-6)
-    finally:
-        sim.close()
+    sections, ahead = _straight_ahead_with("cylinder")
+    assert sections is not None and len(sections.circles) == 1
+    assert ahead == pytest.approx(1.0, abs=1e-6)
