@@ -4,7 +4,8 @@ Why: a layout the robot cannot physically serve used to fail minutes into a run,
 at the bench (issue 14). These four checks refuse it before anything moves, from the robot model's
 geometry (tiago_sim.robot), each with its numbers:
 
-- footprint: the base (radius `BASE_RADIUS`) at the docked pose overlaps a bench; at a station's
+- footprint: the base (radius `BASE_RADIUS`) at the docked pose, or along the straight undock drive to
+  the dock's POI, overlaps a bench; at a station's
   working pose the hotel tray's turning circle (`HOTEL_SWEEP_RADIUS`) plus where the marker-guided
   final approach may end (`WORKING_CLEARANCE`) does: that approach drives at the bearing to the
   working pose and turns to the bench there. With bench edges 0.32 to 0.34 m ahead, `Benchtop`, `Tuck`
@@ -124,6 +125,26 @@ def _footprint_problems(world) -> Iterator[ServiceProblem]:  # noqa: ANN001
     for label, pose, radius in dock_poses:
         for station in world.stations:
             yield from (ServiceProblem(-1, what) for what in _clear(label, pose, radius, station))
+    yield from (ServiceProblem(-1, what) for what in _undock_problems(world, dock_poi))
+
+
+def _undock_problems(world, dock_poi) -> Iterator[str]:  # noqa: ANN001
+    """The undock drives straight from the docked pose to the dock's POI without turning: the base's
+    footprint (the tray lies within it across) plus the navigation error must keep off every bench
+    along it. Random layout 75051 at efb7303 passed a bench 0.265 m from that line and grazed it."""
+    start = world.dock_pose
+    steps = np.linspace(0.0, 1.0, 21)
+    xs, ys = start.x + (dock_poi.x - start.x) * steps, start.y + (dock_poi.y - start.y) * steps
+    need = BASE_RADIUS + TURN_MARGIN
+    for station in world.stations:
+        gaps = bench_distances(station, xs, ys)
+        nearest = int(np.argmin(gaps))
+        if gaps[nearest] < need:
+            yield (
+                f"the undock drive from the docked pose to POI {world.dock_poi} passes {gaps[nearest]:.3f} m "
+                f"from bench {station.name!r} (at x {xs[nearest]:.3f} y {ys[nearest]:.3f} m); the base's "
+                f"footprint and the navigation error need {need:.3f} m"
+            )
 
 
 def _clear(label: str, pose, radius: float, station) -> Iterator[str]:  # noqa: ANN001

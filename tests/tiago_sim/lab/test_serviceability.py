@@ -116,3 +116,28 @@ def test_a_marker_the_head_camera_cannot_see_from_the_poi_is_refused(tmp_path: P
     view = [line for line in problems if "cannot see marker 3 from POI station_a_work" in line]
     assert view and "off its face's normal (at most 60)" in view[0], problems
     assert not any("reach" in line for line in problems)
+
+
+@pytest.mark.parametrize(("bench_y", "refused"), [(-0.35, True), (-0.30, False)])
+def test_a_bench_beside_the_undock_drive_is_refused(tmp_path: Path, bench_y: float, refused: bool) -> None:
+    """Random layout 75051: the undock (straight ahead, no turn) passed a bench 0.265 m off its line
+    and the base grazed it, though the docked pose and the dock's POI were both clear. Here the back of
+    station_b's bench runs 0.30 m (refused) or 0.35 m (accepted) beside the line, its ends clear of both."""
+
+    def beside(data: dict[str, Any]) -> None:
+        data["dock"]["approach_distance"] = 1.6
+        data["stations"][1]["table"]["pose"] = [-0.8, bench_y, -90.0]
+
+    if refused:
+        problems = refusal(tmp_path, beside)
+        assert problems == [
+            f"{tmp_path / 'lab.yaml'}: dock: the undock drive from the docked pose to POI dock_approach "
+            "passes 0.300 m from bench 'station_b' (at x -1.260 y -1.000 m); the base's footprint and the "
+            "navigation error need 0.315 m"
+        ]
+    else:
+        data = copy.deepcopy(DEFAULT)
+        beside(data)
+        path = tmp_path / "lab.yaml"
+        path.write_text(yaml.safe_dump(data, sort_keys=False))
+        load_world(path)
