@@ -35,16 +35,20 @@ def _box(client: int, size, T_world_centre: np.ndarray, rgba=(0.8, 0.5, 0.2, 1))
     return p.createMultiBody(0, shape, visual, position, quat, physicsClientId=client)
 
 
-def _render(plate_xy: tuple[float, float], tool_xy: tuple[float, float], hide_left_end: bool = False):
+def _render(
+    plate_xy: tuple[float, float],
+    tool_xy: tuple[float, float],
+    hide_left_end: bool = False,
+    tilt_deg: float = 0.0,
+):
     """Depth image of the scene and T_world_optical; tool and plate offsets in the site frame (m)."""
     client = p.connect(p.DIRECT)
     try:
         _box(client, (0.7, 1.0, 0.05), T_WORLD_SITE @ tf.make_transform((0, 0, -0.025)), (0.7, 0.7, 0.6, 1))
         bottom = APPROACH
         plate_centre = (plate_xy[0], plate_xy[1], bottom + PLATE.height / 2)
-        _box(
-            client, (PLATE.length, PLATE.width, PLATE.height), T_WORLD_SITE @ tf.make_transform(plate_centre)
-        )
+        tilt = tf.from_xyz_rpy(plate_centre, (0.0, np.radians(tilt_deg), 0.0))  # about the fingers' axis
+        _box(client, (PLATE.length, PLATE.width, PLATE.height), T_WORLD_SITE @ tilt)
         tool_z = bottom + GRASP_HEIGHT
         for side in (-1, 1):  # pads outside the long sides, 80 mm wide, from 5 mm below the tool upwards
             pad_y = plate_xy[1] + side * (PLATE.width / 2 + 0.005)
@@ -66,6 +70,22 @@ def _render(plate_xy: tuple[float, float], tool_xy: tuple[float, float], hide_le
 def test_the_plate_centre_is_found_within_a_millimetre(plate_xy):
     tool_xy = (0.002, 0.001)
     depth, T_world_optical = _render(plate_xy, tool_xy)
+    points = site_points(depth, CameraIntrinsics(), tf.invert(T_WORLD_SITE) @ T_world_optical)
+    tool = np.array([*tool_xy, APPROACH + GRASP_HEIGHT])
+    sighting = locate_held_plate(
+        points, tool, GRASP_HEIGHT, PLATE.length, PLATE.width, PLATE.height, PAD_WIDTH
+    )
+    assert sighting is not None
+    assert abs(sighting.x - plate_xy[0]) < 0.001
+    assert abs(sighting.y - plate_xy[1]) < 0.001
+
+
+@pytest.mark.parametrize("tilt_deg", [-4.0, 2.0, 4.0])
+def test_a_plate_tilted_in_the_hand_is_found_within_a_millimetre(tilt_deg):
+    """Carried plates turn a few degrees about the fingers' axis (random layouts 75083, 75185): a level
+    band about the top's median height cut off both ends, and the plate went down unmeasured."""
+    plate_xy, tool_xy = (0.005, -0.003), (0.0, 0.0)
+    depth, T_world_optical = _render(plate_xy, tool_xy, tilt_deg=tilt_deg)
     points = site_points(depth, CameraIntrinsics(), tf.invert(T_WORLD_SITE) @ T_world_optical)
     tool = np.array([*tool_xy, APPROACH + GRASP_HEIGHT])
     sighting = locate_held_plate(
