@@ -148,13 +148,14 @@ class CampaignOptions:
 
 
 def trial_stack(options: CampaignOptions, trial_seed: int, worker: int = 0) -> DeploymentOptions:
-    """The deployment of one trial: its world (the trial's random layout, or the campaign's), and the
-    worker's own SiLA ports and ROS domain (a requested domain id is shifted by the worker index), and
-    a robot side forked from the prewarmed server (its imports are paid once per campaign)."""
+    """One trial's deployment: its world (random layout or the campaign's); the worker's own SiLA ports,
+    ROS domain (a requested id shifted by the worker index) and CA file (a shared one gave a client
+    another worker's CA: seed 75110, CERTIFICATE_VERIFY_FAILED); a robot side forked prewarmed."""
     extra = ["--disturbance-seed", str(trial_seed), "--disturbance-levels", levels_json(options.levels)]
-    layouts, domain_id = options.layouts_dir, options.stack.domain_id
+    layouts, domain_id, ca = options.layouts_dir, options.stack.domain_id, options.stack.ca_file
     return replace(
         options.stack,
+        ca_file=ca if worker == 0 else ca.with_name(f"{ca.stem}-worker{worker}{ca.suffix}"),
         world=options.stack.world if layouts is None else layout_path(layouts, trial_seed),
         extra_sim_arguments=extra,
         port_base=options.stack.port_base + PORTS_PER_WORKER * worker,

@@ -28,12 +28,15 @@ SEED = 5150
 DEFAULT_WORLD = Path(__file__).resolve().parents[3] / "tiago_sim" / "worlds" / "default.yaml"
 
 
-def test_each_worker_gets_its_own_ports_and_domain_and_each_trial_its_layout(tmp_path: Path) -> None:
-    stack = DeploymentOptions(world=Path("lab.yaml"), port_base=57000, domain_id=40)
+def test_each_worker_gets_its_own_ports_domain_and_ca_file_and_each_trial_its_layout(tmp_path: Path) -> None:
+    stack = DeploymentOptions(
+        world=Path("lab.yaml"), port_base=57000, domain_id=40, ca_file=tmp_path / "ca.pem"
+    )
     options = CampaignOptions(stack, SEED, 4, default_level_values(), jobs=2, layouts_dir=tmp_path)
     first, second = trial_stack(options, SEED, worker=0), trial_stack(options, SEED + 1, worker=1)
     assert (first.port_base, first.domain_id, first.world) == (57000, 40, tmp_path / f"layout_{SEED}.yaml")
     assert (second.port_base, second.domain_id) == (57010, 41)
+    assert (first.ca_file, second.ca_file) == (tmp_path / "ca.pem", tmp_path / "ca-worker1.pem")
     arguments = second.extra_sim_arguments
     assert arguments[arguments.index("--disturbance-seed") + 1] == str(SEED + 1)
     fixed = CampaignOptions(stack, SEED, 1, default_level_values())
