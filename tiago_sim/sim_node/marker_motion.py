@@ -43,6 +43,7 @@ from tiago_sim.sim_node.place_correction import place_shift
 log = logging.getLogger(__name__)
 
 TARGETS = ("site_approach", "site", "work_pose")
+LINE_ONLY_RADIUS_M = 0.03  # a tool this near the column above the site moves only in straight lines
 CAMERA_FRAME = "head_camera_optical_frame"
 # A cached marker stays valid while odometry moved less than this.
 SAME_BASE_POSITION_M = 0.002
@@ -144,6 +145,16 @@ class MarkerMotionBehaviour:
             return T_base_site
         return T_base_site @ tf.make_transform((float(shift[0]), float(shift[1]), 0.0))
 
+    def _may_leave_the_line(self, run: ActionRun, arm: str, T_base_target: np.ndarray) -> bool:
+        """Whether a move to the site's approach pose may go in joint space where no straight line has
+        IK: from anywhere but straight below it (a tool in the nest, or just out of it, must rise
+        straight). From the arm-to-bench pose to the far nest of a 4-nest row the line left the arm's
+        reach at waypoint 12 of 34 (random layout 75164 at efb7303); the contact watch still stops a
+        joint-space move that touches anything."""
+        joints = run.sim(lambda sim: dict(sim.joint_positions()))
+        tool = self.behaviours.tool_pose(arm, joints)[:3, 3]
+        return float(np.hypot(*(tool[:2] - T_base_target[:2, 3]))) > LINE_ONLY_RADIUS_M
+
     def __call__(self, run: ActionRun, goal: Any) -> dict:
         arm = self.behaviours.arm_of(goal.arm)
         try:
@@ -205,7 +216,9 @@ class MarkerMotionBehaviour:
             try:
                 self.behaviours.straight_move(run, arm, T_base_target, speed, (first, 1.0))
             except ActionAbort as abort:
-                if first <= 0.1 or abort.code != ErrorCodes.IK_FAILED:
+                if abort.code != ErrorCodes.IK_FAILED or not self._may_leave_the_line(
+                    run, arm, T_base_target
+                ):
                     raise
                 self.behaviours.joint_space_move(run, arm, T_base_target, (first, 1.0))
         except ActionAbort as abort:
