@@ -270,6 +270,15 @@ def _radians(values: tuple[float, float, float]) -> tuple[float, float, float]:
     return (roll, pitch, yaw)
 
 
+def station_from_raw(raw: Any) -> Station | None:
+    """One station's mapping as the program reads it, or None if it breaks the schema; none of the
+    checks that need the rest of the lab (a layout generator's quick look at a candidate)."""
+    try:
+        return _station(schema.Station.model_validate(raw))
+    except ValueError:  # pydantic's ValidationError
+        return None
+
+
 def _station(item: schema.Station) -> Station:
     return Station(
         name=item.name,

