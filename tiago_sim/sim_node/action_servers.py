@@ -68,6 +68,12 @@ class RobotActivity:
         with self._lock:
             self.state, self.detail, self.last_error, self._begun = "", "", "", []
 
+    def signature(self) -> tuple[str, str, str, int]:
+        """What the next report would show, without taking the goals begun since the last one (for
+        a publisher to tell news from a robot standing still)."""
+        with self._lock:
+            return (self.state, self.detail, self.last_error, len(self._begun))
+
     def snapshot(self) -> ActivityReport:
         """The current (state or "", detail), and the activities begun and ended since the last call."""
         with self._lock:

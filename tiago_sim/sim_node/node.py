@@ -100,6 +100,7 @@ class SimNode:
             sim_thread,
             pois=self.current_pois,
             activity=self.actions.activity.snapshot,
+            activity_signature=self.actions.activity.signature,
             localisation=self.localisation,
         )
         self.lab_reset = LabReset(node, sim_thread, self.actions.slot)
