@@ -36,6 +36,15 @@ def refusal(tmp_path: Path, change: Callable[[dict[str, Any]], Any]) -> list[str
     return list(refused.value.problems)
 
 
+def accepted(tmp_path: Path, change: Callable[[dict[str, Any]], Any]) -> None:
+    """The default lab with `change` made loads."""
+    data = copy.deepcopy(DEFAULT)
+    change(data)
+    path = tmp_path / "lab.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    load_world(path)
+
+
 @pytest.mark.parametrize("world", sorted(SCHEMA_FILE.parent.glob("*.yaml")), ids=lambda p: p.name)
 def test_every_shipped_world_passes_the_robot_checks(world: Path) -> None:
     load_world(world)
@@ -88,11 +97,7 @@ def test_a_working_pose_within_the_tray_s_reach_plus_the_approach_error_is_refus
         problems = refusal(tmp_path, nearer)
         assert any(f"is {from_bench:.3f} m from bench 'station_a'" in line for line in problems), problems
     else:
-        data = copy.deepcopy(DEFAULT)
-        nearer(data)
-        path = tmp_path / "lab.yaml"
-        path.write_text(yaml.safe_dump(data, sort_keys=False))
-        load_world(path)
+        accepted(tmp_path, nearer)
 
 
 def test_stations_too_close_for_the_hotel_tray_to_turn_are_refused(tmp_path: Path) -> None:
@@ -136,8 +141,4 @@ def test_a_bench_beside_the_undock_drive_is_refused(tmp_path: Path, bench_y: flo
             "navigation error need 0.315 m"
         ]
     else:
-        data = copy.deepcopy(DEFAULT)
-        beside(data)
-        path = tmp_path / "lab.yaml"
-        path.write_text(yaml.safe_dump(data, sort_keys=False))
-        load_world(path)
+        accepted(tmp_path, beside)

@@ -68,8 +68,11 @@ def _render(
 
 @pytest.mark.parametrize("plate_xy", [(0.0, 0.0), (0.009, -0.004), (-0.006, 0.003)])
 def test_the_plate_centre_is_found_within_a_millimetre(plate_xy):
-    tool_xy = (0.002, 0.001)
-    depth, T_world_optical = _render(plate_xy, tool_xy)
+    _assert_found_within_a_millimetre(plate_xy, (0.002, 0.001))
+
+
+def _assert_found_within_a_millimetre(plate_xy, tool_xy, tilt_deg: float = 0.0) -> None:
+    depth, T_world_optical = _render(plate_xy, tool_xy, tilt_deg=tilt_deg)
     points = site_points(depth, CameraIntrinsics(), tf.invert(T_WORLD_SITE) @ T_world_optical)
     tool = np.array([*tool_xy, APPROACH + GRASP_HEIGHT])
     sighting = locate_held_plate(
@@ -84,16 +87,7 @@ def test_the_plate_centre_is_found_within_a_millimetre(plate_xy):
 def test_a_plate_tilted_in_the_hand_is_found_within_a_millimetre(tilt_deg):
     """Carried plates turn a few degrees about the fingers' axis (random layouts 75083, 75185): a level
     band about the top's median height cut off both ends, and the plate went down unmeasured."""
-    plate_xy, tool_xy = (0.005, -0.003), (0.0, 0.0)
-    depth, T_world_optical = _render(plate_xy, tool_xy, tilt_deg=tilt_deg)
-    points = site_points(depth, CameraIntrinsics(), tf.invert(T_WORLD_SITE) @ T_world_optical)
-    tool = np.array([*tool_xy, APPROACH + GRASP_HEIGHT])
-    sighting = locate_held_plate(
-        points, tool, GRASP_HEIGHT, PLATE.length, PLATE.width, PLATE.height, PAD_WIDTH
-    )
-    assert sighting is not None
-    assert abs(sighting.x - plate_xy[0]) < 0.001
-    assert abs(sighting.y - plate_xy[1]) < 0.001
+    _assert_found_within_a_millimetre((0.005, -0.003), (0.0, 0.0), tilt_deg)
 
 
 def test_a_plate_with_an_end_hidden_gives_no_measurement():
