@@ -118,6 +118,12 @@ def bench_distances(station, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:  # n
     return np.where(outside > 0, outside, np.maximum(along, across))
 
 
+def drive_points(start, end, count: int) -> tuple[np.ndarray, np.ndarray]:  # noqa: ANN001 - Pose2D
+    """`count` + 1 floor points evenly along the straight drive from `start` to `end`, both ends in."""
+    k = np.arange(count + 1, dtype=float) / count
+    return start.x + (end.x - start.x) * k, start.y + (end.y - start.y) * k
+
+
 def _footprint_problems(world) -> Iterator[ServiceProblem]:  # noqa: ANN001
     dock_poses = (("the docked pose", world.dock_pose, BASE_RADIUS),)
     dock_poi = world.pois[world.dock_poi]
@@ -132,9 +138,7 @@ def _undock_problems(world, dock_poi) -> Iterator[str]:  # noqa: ANN001
     """The undock drives straight from the docked pose to the dock's POI without turning: the base's
     footprint (the tray lies within it across) plus the navigation error must keep off every bench
     along it. Random layout 75051 at efb7303 passed a bench 0.265 m from that line and grazed it."""
-    start = world.dock_pose
-    steps = np.linspace(0.0, 1.0, 21)
-    xs, ys = start.x + (dock_poi.x - start.x) * steps, start.y + (dock_poi.y - start.y) * steps
+    xs, ys = drive_points(world.dock_pose, dock_poi, 20)
     need = BASE_RADIUS + TURN_MARGIN
     for station in world.stations:
         gaps = bench_distances(station, xs, ys)

@@ -141,8 +141,8 @@ class StatePublishers:
         # While no goal runs and none began or ended since the last report, reports go out at
         # idle_rate_hz: a robot standing still changes nothing a 20 Hz report would show, and the
         # ticks (a snapshot on the sim thread, six messages built and read by the bridge and the
-        # sequencer) were about a tenth of a campaign trial's CPU (0.7 of 7.6 s), mostly while the
-        # robot stood between two goals. A goal's start or end is reported at the next 20 Hz tick.
+        # sequencer) cost about 5 % of a campaign trial's CPU between goals (paired runs, README
+        # "Campaign speed"). A goal's start or end is reported at the next 20 Hz tick.
         self.activity_signature = activity_signature
         self.idle_period_s = 1.0 / idle_rate_hz
         self._reported_signature: tuple | None = None
