@@ -38,6 +38,9 @@ log = logging.getLogger(__name__)
 CAMERA_IMAGE_TOPIC = "/head_front_camera/rgb/image_raw"
 CAMERA_INFO_TOPIC = "/head_front_camera/rgb/camera_info"
 CAMERA_FRAME = "head_camera_optical_frame"
+# The robot state and station states go out at least this often (s), news or not: a reader's
+# clock (SimulatedLabController.SimulatedTime reads the last /robot_state's stamp) is never staler.
+SLOW_PERIOD_S = 0.5
 SNAPSHOT_WAIT_S = 0.03  # s a state tick waits for the sim thread's snapshot (ticks are 50 ms apart)
 
 
@@ -203,7 +206,10 @@ class StatePublishers:
         signature = self.activity_signature()
         if signature[0] or signature != self._reported_signature:
             return False
-        return time.monotonic() - self._reported_at < self.idle_period_s
+        now = time.monotonic()
+        if now - self._last_slow_publish >= SLOW_PERIOD_S:  # the periodic reports keep their beat
+            return False
+        return now - self._reported_at < self.idle_period_s
 
     def _snapshot_with_activity(self, sim: Any) -> RobotSnapshot:
         """Sensors and activity read at the same instant (on the sim thread): a state read later
@@ -246,7 +252,7 @@ class StatePublishers:
             state.holding,
         )
         now = time.monotonic()
-        slow_due = now - self._last_slow_publish >= 0.5
+        slow_due = now - self._last_slow_publish >= SLOW_PERIOD_S
         robot_news = key != self._last_robot_key
         if robot_news or slow_due:
             self.robot_state_pub.publish(state)
