@@ -22,6 +22,7 @@ from tiago_sim import transforms as tf
 from tiago_sim.lab.world import MARKER_BOARD_SCALE, Obstacle, Station, World
 from tiago_sim.navigation.occupancy_map import DOCK_GAP, DOCK_SIZE, WALL_THICKNESS
 from tiago_sim.perception.marker_asset import marker_visual
+from tiago_sim.physics.gridded_box import GRID_CELL, gridded_box_visual
 from tiago_sim.robot.hotel_model import corner_ramp_boxes
 from tiago_sim.robot.robot_model import BASE_RADIUS
 
@@ -36,7 +37,6 @@ NEST_LEG_LENGTH = 0.015  # bracket legs run this far in from each corner
 NEST_FRICTION = 0.15  # polished lead-ins: with the plate's 1.0, the pair's friction is 0.15
 TABLE_FRICTION = 0.3  # laminate bench top: plate on table 0.3
 FLOOR_RGBA = [0.85, 0.85, 0.85, 1.0]
-FLOOR_VISUAL_CELLS = 16  # per side
 WALL_HEIGHT = 1.0  # m: the floor's edge walls (the map's walls; the base laser sees them)
 
 
@@ -57,13 +57,21 @@ class Scene:
 
 
 def _static_box(client: int, size, T_world_box: np.ndarray, rgba, collide: bool = True) -> int:
+    """A static box; one larger than a grid cell is seen as a gridded mesh (cheaper to render)."""
     half = [s / 2 for s in size]
     collision = (
         p.createCollisionShape(p.GEOM_BOX, halfExtents=half, physicsClientId=client) if collide else -1
     )
-    visual = p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=rgba, physicsClientId=client)
+    gridded = max(size) > GRID_CELL
+    if gridded:
+        visual = gridded_box_visual(client, half, rgba)
+    else:
+        visual = p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=rgba, physicsClientId=client)
     position, quat = tf.to_pose(T_world_box)
-    return p.createMultiBody(0.0, collision, visual, position.tolist(), quat.tolist(), physicsClientId=client)
+    body = p.createMultiBody(0.0, collision, visual, position.tolist(), quat.tolist(), physicsClientId=client)
+    if gridded:  # a mesh's own colour is ignored
+        p.changeVisualShape(body, -1, rgbaColor=rgba, physicsClientId=client)
+    return body
 
 
 def nest_boxes(length: float, width: float) -> list[tuple[tuple, tuple, tuple]]:
@@ -109,7 +117,7 @@ def _compound_static(client: int, boxes, T_world_body: np.ndarray, rgba) -> int:
     return p.createMultiBody(0.0, collision, visual, position.tolist(), quat.tolist(), physicsClientId=client)
 
 
-def _build_station(client: int, station: Station, labware: LabwareType, scene: Scene) -> None:
+def _build_table(client: int, station: Station, scene: Scene) -> None:
     depth, width, height = station.table_size
     T_world_top = station.T_world_table()
     scene.tables[station.name] = _static_box(
@@ -119,16 +127,22 @@ def _build_station(client: int, station: Station, labware: LabwareType, scene: S
         [0.75, 0.7, 0.6, 1],
     )
     p.changeDynamics(scene.tables[station.name], -1, lateralFriction=TABLE_FRICTION, physicsClientId=client)
-    # marker on a thin board standing behind it
+
+
+def _build_marker(client: int, station: Station, scene: Scene) -> None:
+    """The marker tile, then the thin board standing behind it (the tile hides part of the board)."""
     T_world_marker = station.T_world_marker()
+    T_world_tile = T_world_marker @ tf.make_transform((0, 0, 0.0008))
+    scene.markers[station.name] = marker_visual(client, station.marker_id, station.marker_size, T_world_tile)
     board = station.marker_size * MARKER_BOARD_SCALE
     stand_height = station.marker_stand_height()
     T_world_board = T_world_marker @ tf.make_transform((0, stand_height / 2 - station.marker_xyz[2], -0.006))
     scene.marker_stands[station.name] = _static_box(
         client, (board, stand_height, 0.01), T_world_board, [0.95, 0.95, 0.95, 1]
     )
-    T_world_tile = T_world_marker @ tf.make_transform((0, 0, 0.0008))
-    scene.markers[station.name] = marker_visual(client, station.marker_id, station.marker_size, T_world_tile)
+
+
+def _build_nests(client: int, station: Station, labware: LabwareType, scene: Scene) -> None:
     pocket = (labware.length + 2 * station.nest_clearance, labware.width + 2 * station.nest_clearance)
     boxes = nest_boxes(pocket[0], pocket[1])
     for nest in station.nests():
@@ -176,36 +190,8 @@ def _build_walls(client: int, floor_size: float) -> dict[str, int]:
 
 
 def _floor_body(client: int, size: float, thickness: float = 0.02) -> int:
-    """The floor: a box to collide with, seen as its top face cut into `FLOOR_VISUAL_CELLS` squares.
-
-    Why not the box's own visual: PyBullet's software renderer walks every pixel of a triangle's
-    bounding box, and the box's two top triangles (and two bottom ones, hidden but still drawn) span
-    the whole image; the floor cost 24 of 58 ms per head-camera image. Smaller triangles render the
-    same pixels about a fifth faster overall (identical RGB, depth to float rounding:
-    tests/tiago_sim/physics/test_scene_floor.py)."""
-    half = size / 2
-    collision = p.createCollisionShape(
-        p.GEOM_BOX, halfExtents=[half, half, thickness / 2], physicsClientId=client
-    )
-    cells = FLOOR_VISUAL_CELLS
-    steps = np.linspace(-half, half, cells + 1)
-    vertices = [[x, y, thickness / 2] for y in steps for x in steps]
-    indices = []
-    for row in range(cells):
-        for column in range(cells):
-            corner = row * (cells + 1) + column
-            above = corner + cells + 1
-            indices += [corner, corner + 1, above + 1, corner, above + 1, above]  # counter-clockwise: up
-    visual = p.createVisualShape(
-        p.GEOM_MESH,
-        vertices=vertices,
-        indices=indices,
-        normals=[[0.0, 0.0, 1.0]] * len(vertices),
-        physicsClientId=client,
-    )
-    floor = p.createMultiBody(0.0, collision, visual, [0.0, 0.0, -thickness / 2], physicsClientId=client)
-    p.changeVisualShape(floor, -1, rgbaColor=FLOOR_RGBA, physicsClientId=client)  # a mesh's own is ignored
-    return floor
+    """The floor: a static box whose top face is at z = 0."""
+    return _static_box(client, (size, size, thickness), tf.make_transform((0, 0, -thickness / 2)), FLOOR_RGBA)
 
 
 def _obstacle_body(client: int, obstacle: Obstacle) -> int:
@@ -235,20 +221,18 @@ def plate_bottom_pose(client: int, body: int, labware: LabwareType) -> np.ndarra
 
 
 def build_scene(client: int, world: World, T_world_hotel_slots: dict[int, np.ndarray] | None = None) -> Scene:
-    """Create floor, dock, stations and plates; hotel plates need the slot poses of the placed robot."""
+    """Create the lab and its plates; hotel plates need the slot poses of the placed robot.
+
+    Bodies are created front to back (markers, plates, nests, tables, then dock, obstacles, walls
+    and floor) because creation order is draw order in PyBullet's software renderer, which tests
+    depth before it shades a pixel: a bench, wall or floor drawn after what stands on or before it
+    never shades the hidden pixels. Same images (tests/tiago_sim/physics/test_scene_draw_order.py),
+    about a fifth cheaper at a bench.
+    """
     scene = Scene()
-    half_floor = world.floor_size / 2
-    scene.floor = _floor_body(client, world.floor_size)
-    log.debug("floor %.1f m square (half %.1f)", world.floor_size, half_floor)
-    T_world_dock = world.dock_pose.matrix() @ tf.make_transform(
-        (-(BASE_RADIUS + DOCK_GAP + DOCK_SIZE[0] / 2), 0, DOCK_SIZE[2] / 2)
-    )
-    scene.dock = _static_box(client, DOCK_SIZE, T_world_dock, [0.2, 0.3, 0.2, 1])
-    scene.walls = _build_walls(client, world.floor_size)
-    scene.obstacles = {obstacle.name: _obstacle_body(client, obstacle) for obstacle in world.obstacles}
     default_type = next(iter(world.labware_types.values()))
     for station in world.stations:
-        _build_station(client, station, default_type, scene)
+        _build_marker(client, station, scene)
     for plate, holder in world.plates.items():
         labware = world.labware_types[plate.labware_type]
         if isinstance(holder, HotelSlot):
@@ -259,4 +243,16 @@ def build_scene(client: int, world: World, T_world_hotel_slots: dict[int, np.nda
             T_world_bottom = world.station(holder.station).T_world_site(holder.sub_position)
         scene.plates[plate.labware_id] = _plate_body(client, labware, T_world_bottom)
         scene.plate_types[plate.labware_id] = labware
+    for station in world.stations:
+        _build_nests(client, station, default_type, scene)
+    for station in world.stations:
+        _build_table(client, station, scene)
+    T_world_dock = world.dock_pose.matrix() @ tf.make_transform(
+        (-(BASE_RADIUS + DOCK_GAP + DOCK_SIZE[0] / 2), 0, DOCK_SIZE[2] / 2)
+    )
+    scene.dock = _static_box(client, DOCK_SIZE, T_world_dock, [0.2, 0.3, 0.2, 1])
+    scene.obstacles = {obstacle.name: _obstacle_body(client, obstacle) for obstacle in world.obstacles}
+    scene.walls = _build_walls(client, world.floor_size)
+    scene.floor = _floor_body(client, world.floor_size)
+    log.debug("floor %.1f m square", world.floor_size)
     return scene
