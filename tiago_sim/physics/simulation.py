@@ -51,7 +51,7 @@ log = logging.getLogger(__name__)
 SOLVER_ITERATIONS_GRASPING = 150
 SOLVER_ITERATIONS = 20
 # Physics step: the notes' 1/240 s whenever a gripper moves, or a moving link (arm, torso, head)
-# comes within PLATE_NEAR_RANGE of a plate resting anywhere, or a held plate comes within reach of
+# comes within reach of a plate resting anywhere (plate_proximity.py), or a held plate comes within reach of
 # anything but its own arm (grasp, place, release, into and out of the hotel); FREE_MOTION_STEP_RATIO
 # times that otherwise (driving, free arm moves, carrying through free space), where only joint
 # tracking, the kinematic base and constrained plates are simulated. The long step is the largest
@@ -61,12 +61,17 @@ SOLVER_ITERATIONS = 20
 # contact alone used to keep the steps short while the base turned (it crept outwards per step on
 # the curved path); the hotel clamp now holds it while the base moves.
 FREE_MOTION_STEP_RATIO = 4
+# Only the base driving (no other motion, no plate in reach): twice as long, half of a transfer's
+# simulated time (seed 40001: 2.22 instead of 2.71 s CPU in motion). Not for arm motions: at 1/30 s
+# the wrists missed SETTLE_TOLERANCE by 3 to 11 mrad (7 of 8 transfers failed).
+DRIVE_STEP_RATIO = 8
 # Error reduction of joint constraints (the base carrier) per step: Bullet's 0.2 at 1/240 s, 0.5 at
 # the long step, so that the base lags its commanded pose by the same 17 ms at either step (about
 # step * (1 - erp) / erp; measured at 0.27 and 0.53 m/s: 16.7 ms at 1/240 s and 0.2, 20.4 ms at
 # 1/60 s and 0.45, 11.1 ms at 1/60 s and 0.6).
 CONSTRAINT_ERP = 0.2
 FREE_MOTION_CONSTRAINT_ERP = 0.5
+DRIVE_CONSTRAINT_ERP = 0.66  # the same lag at 1/30 s: 17.2 ms at 0.27 and 0.53 m/s
 LOADED_TURN_RATE = 0.05  # rad/s: above it, with an unclamped plate in the hotel, steps stay short
 DOCK_SENSOR_RANGE = 0.004  # m: the charging contacts close within this distance
 TOOL_SPEED = 0.08  # m/s along straight tool moves unless the caller asks otherwise
@@ -205,10 +210,14 @@ class Simulation:
             self._iterations = iterations
             p.setPhysicsEngineParameter(numSolverIterations=iterations, physicsClientId=self.client_id)
         short = grasping or self._plate_within_range or self._turning_loaded
-        step = self.time_step if short else self.time_step * FREE_MOTION_STEP_RATIO
+        if short:
+            step, erp = self.time_step, CONSTRAINT_ERP
+        elif self.motions and all(motion.resources <= {"base"} for motion in self.motions):
+            step, erp = self.time_step * DRIVE_STEP_RATIO, DRIVE_CONSTRAINT_ERP
+        else:
+            step, erp = self.time_step * FREE_MOTION_STEP_RATIO, FREE_MOTION_CONSTRAINT_ERP
         if step != self._step:
             self._step = step
-            erp = CONSTRAINT_ERP if step == self.time_step else FREE_MOTION_CONSTRAINT_ERP
             p.setPhysicsEngineParameter(fixedTimeStep=step, erp=erp, physicsClientId=self.client_id)
         return step
 

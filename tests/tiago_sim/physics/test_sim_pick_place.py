@@ -18,7 +18,8 @@ from labware_model.readings import HotelSlotReading, NestReading
 from tests.helpers.sim_steps import step_for, step_lengths
 from tiago_sim import transforms as tf
 from tiago_sim.lab.world import load_world
-from tiago_sim.physics.simulation import FREE_MOTION_STEP_RATIO, HOME_ARM, Simulation
+from tiago_sim.physics.plate_proximity import CONTACT_MARGIN, STEP_REVIEW_PERIOD
+from tiago_sim.physics.simulation import FREE_MOTION_STEP_RATIO, HOME_ARM, TOOL_SPEED, Simulation
 from tiago_sim.robot import robot_model as rm
 from tiago_sim.robot.kinematics import top_down_grasp
 
@@ -144,6 +145,38 @@ def test_a_held_plate_takes_long_steps_in_free_space_and_short_ones_near_the_tab
         assert sim.check_placement(PLATE).location == GRIPPER
     finally:
         sim.close()
+
+
+def _gap_to_plate(sim: Simulation) -> float:
+    """The nearest robot link (not the base) to the plate, in m (0.3 when none is within 0.3 m)."""
+    points = p.getClosestPoints(sim.robot.id, sim.scene.plates[PLATE], 0.3, physicsClientId=sim.client_id)
+    return min((point[8] for point in points if point[3] != -1), default=0.3)
+
+
+def test_a_descent_onto_a_resting_plate_takes_short_steps_only_within_reach_of_it():
+    """Long steps while the tool is further than it can travel before the next review (plus the
+    margin), short ones from there on: the contact physics never starts on a long step."""
+    sim = Simulation(load_world(), seed=11)
+    script = Script(sim)
+    try:
+        script.run(sim.undock(), "undock")
+        script.drive("station_a_work")
+        T_base_site = script.site_in_base("station_a", 1)
+        script.run(sim.move_tool(ARM, script.grasp(T_base_site, CARRY), straight_line=False), "above")
+        descent = sim.move_tool(ARM, script.grasp(T_base_site))
+        steps = []
+        while not descent.done:
+            gap = _gap_to_plate(sim)
+            sim.step()
+            steps.append((gap, sim.last_step_s))
+        assert descent.success, descent
+    finally:
+        sim.close()
+    long_step = sim.time_step * FREE_MOTION_STEP_RATIO
+    reach = CONTACT_MARGIN + 2 * TOOL_SPEED * STEP_REVIEW_PERIOD
+    assert all(step == sim.time_step for gap, step in steps if gap < CONTACT_MARGIN)
+    far = [step for gap, step in steps if gap > reach + TOOL_SPEED * STEP_REVIEW_PERIOD]
+    assert len(far) > 20 and set(far) == {long_step}  # before: short from 0.15 m on
 
 
 def test_closing_on_nothing_reports_not_holding():

@@ -13,7 +13,7 @@ import pybullet as p
 from tests.helpers.sim_steps import step_lengths
 from tiago_sim import transforms as tf
 from tiago_sim.lab.world import load_world
-from tiago_sim.physics.simulation import FREE_MOTION_STEP_RATIO, Simulation
+from tiago_sim.physics.simulation import DRIVE_STEP_RATIO, FREE_MOTION_STEP_RATIO, HOME_ARM, Simulation
 
 PLATE = "plate_001"
 
@@ -33,11 +33,13 @@ def _plate_in_base(sim: Simulation) -> np.ndarray:
     return tf.invert(sim.robot.base_pose()) @ sim.plate_bottom_pose(PLATE)
 
 
-def test_driving_takes_long_steps_and_a_gripper_motion_short_ones():
+def test_driving_takes_the_longest_steps_an_arm_motion_long_ones_and_a_gripper_motion_short_ones():
     sim = Simulation(load_world(), seed=4)
     try:
-        long_step = sim.time_step * FREE_MOTION_STEP_RATIO
-        assert set(step_lengths(sim, sim.undock())) == {long_step}
+        assert set(step_lengths(sim, sim.undock())) == {sim.time_step * DRIVE_STEP_RATIO}
+        folded = dict(zip([f"arm_right_{i}_joint" for i in range(1, 8)], HOME_ARM, strict=True))
+        unfolded = {**folded, "arm_right_1_joint": HOME_ARM[0] + 0.4}
+        assert set(step_lengths(sim, sim.move_joints(unfolded))) == {sim.time_step * FREE_MOTION_STEP_RATIO}
         closing = step_lengths(sim, sim.gripper("right", close=True))
         assert closing and set(closing) == {sim.time_step}
     finally:
@@ -51,7 +53,7 @@ def test_plate_in_the_hotel_rides_a_drive_clamped_at_long_steps_without_slipping
         _put_plate_in_hotel(sim, 1)
         assert sim.hotel_readings()[0].labware_id == PLATE
         before = _plate_in_base(sim)
-        long_step = sim.time_step * FREE_MOTION_STEP_RATIO
+        long_step = sim.time_step * DRIVE_STEP_RATIO
         assert set(step_lengths(sim, sim.undock())) == {long_step}
         lab = world.pois["lab_centre"]
         drive = sim.drive_to(lab.x, lab.y, lab.yaw)
