@@ -122,15 +122,26 @@ def test_plate_goes_from_station_a_through_the_hotel_to_station_b():
         sim.close()
 
 
-def test_a_held_plate_takes_long_steps_in_free_space_and_short_ones_near_the_table():
-    """The long step is where the simulation wins its speed; a held plate gets it only out of reach."""
+def _tool_above_station_a(height: float) -> tuple[Simulation, Script, np.ndarray]:
+    """Driven to station A's working pose, the open tool ``height`` above its plate; the caller closes
+    the simulation."""
     sim = Simulation(load_world(), seed=11)
     script = Script(sim)
     try:
         script.run(sim.undock(), "undock")
         script.drive("station_a_work")
         T_base_site = script.site_in_base("station_a", 1)
-        script.run(sim.move_tool(ARM, script.grasp(T_base_site, APPROACH), straight_line=False), "approach")
+        script.run(sim.move_tool(ARM, script.grasp(T_base_site, height), straight_line=False), "approach")
+    except BaseException:
+        sim.close()
+        raise
+    return sim, script, T_base_site
+
+
+def test_a_held_plate_takes_long_steps_in_free_space_and_short_ones_near_the_table():
+    """The long step is where the simulation wins its speed; a held plate gets it only out of reach."""
+    sim, script, T_base_site = _tool_above_station_a(APPROACH)
+    try:
         script.run(sim.move_tool(ARM, script.grasp(T_base_site)), "descend")
         script.run(sim.gripper(ARM, close=True), "close")
         long_step = sim.time_step * FREE_MOTION_STEP_RATIO
@@ -156,13 +167,8 @@ def _gap_to_plate(sim: Simulation) -> float:
 def test_a_descent_onto_a_resting_plate_takes_short_steps_only_within_reach_of_it():
     """Long steps while the tool is further than it can travel before the next review (plus the
     margin), short ones from there on: the contact physics never starts on a long step."""
-    sim = Simulation(load_world(), seed=11)
-    script = Script(sim)
+    sim, script, T_base_site = _tool_above_station_a(CARRY)
     try:
-        script.run(sim.undock(), "undock")
-        script.drive("station_a_work")
-        T_base_site = script.site_in_base("station_a", 1)
-        script.run(sim.move_tool(ARM, script.grasp(T_base_site, CARRY), straight_line=False), "above")
         descent = sim.move_tool(ARM, script.grasp(T_base_site))
         steps = []
         while not descent.done:
