@@ -217,7 +217,9 @@ def draw_detection(
     """Copy of ``rgb`` with the marker outlined, its axes drawn (x red, y green, z blue) and labelled."""
     canvas = np.ascontiguousarray(rgb.copy())
     outline = np.round(observation.corners_px).astype(np.int32).reshape(-1, 1, 2)
-    cv2.polylines(canvas, [outline], isClosed=True, color=(255, 200, 0), thickness=1, lineType=cv2.LINE_AA)
+    # 2 px in the exact colour (no anti-aliasing): a 1 px blended line kept as few as 5 pixels of its
+    # colour around a small, oblique marker, too few to see (or for a test to find) in a saved frame
+    cv2.polylines(canvas, [outline], isClosed=True, color=(255, 200, 0), thickness=2, lineType=cv2.LINE_8)
     rvec = cv2.Rodrigues(observation.T_optical_marker[:3, :3])[0]
     tvec = observation.T_optical_marker[:3, 3]
     # drawFrameAxes colours axes in BGR order; the canvas is RGB, so pass through a BGR view.
