@@ -120,3 +120,25 @@ def test_the_hotel_clamp_opens_on_a_plate_something_falls_on():
         sim.run(drive)
     finally:
         sim.close()
+
+
+def test_the_step_where_the_physics_step_changes_length_counts_no_acceleration():
+    """A velocity jump on the first step of another length is the position control's discretisation
+    (it corrects a tracking error faster at the shorter step), not a load; the next one counts."""
+    sim, _script, _site = _grasp_at_station_a(16.0)
+    try:
+        client, plate = sim.client_id, sim.scene.plates[PLATE]
+        monitor = GripLoadMonitor(client, sim.robot.id, plate, sim.grippers[ARM].finger_links, 16.0)
+        grasp = sim.robot.link_pose(f"arm_{ARM}_grasping_frame")
+        along = grasp[:3, 0]  # in the pad plane
+        p.resetBaseVelocity(plate, [0.0, 0.0, 0.0], physicsClientId=client)
+        monitor.load(1 / 60, grasp)
+        still = monitor.load(1 / 60, grasp)  # weight and the nest's push only
+        p.resetBaseVelocity(plate, (0.2 * along).tolist(), physicsClientId=client)  # 48 m/s^2 at 1/240 s
+        switched = monitor.load(1 / 240, grasp)
+        p.resetBaseVelocity(plate, (0.4 * along).tolist(), physicsClientId=client)
+        after = monitor.load(1 / 240, grasp)
+    finally:
+        sim.close()
+    assert switched.in_plane_n == pytest.approx(still.in_plane_n, abs=1e-6)
+    assert after.in_plane_n > still.in_plane_n + 10.0  # 0.35 kg x 48 m/s^2 = 16.8 N
