@@ -53,7 +53,7 @@ SOLVER_ITERATIONS = 20
 # Physics step: the notes' 1/240 s whenever a gripper moves, or a moving link (arm, torso, head)
 # comes within reach of a plate resting anywhere (plate_proximity.py), or a held plate comes within reach of
 # anything but its own arm (grasp, place, release, into and out of the hotel); FREE_MOTION_STEP_RATIO
-# times that otherwise (driving, free arm moves, carrying through free space), where only joint
+# times that otherwise (free arm moves, carrying through free space; driving: below), where only joint
 # tracking, the kinematic base and constrained plates are simulated. The long step is the largest
 # saving of wall time per simulated second: 1/60 s halved the steps of the free phases against
 # 1/120 s (a benchmark transfer: 2230 instead of 4260 steps, 0.6 s CPU less) with the marker-guided
