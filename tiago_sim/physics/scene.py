@@ -226,8 +226,8 @@ def build_scene(client: int, world: World, T_world_hotel_slots: dict[int, np.nda
     Bodies are created front to back (markers, plates, nests, tables, then dock, obstacles, walls
     and floor) because creation order is draw order in PyBullet's software renderer, which tests
     depth before it shades a pixel: a bench, wall or floor drawn after what stands on or before it
-    never shades the hidden pixels. Same images (tests/tiago_sim/physics/test_scene_draw_order.py),
-    about a fifth cheaper at a bench.
+    never shades the hidden pixels. Same images (tests/tiago_sim/physics/test_scene_gridded_boxes.py),
+    about an eighth cheaper at a bench (682 -> 602 ms for five frames, before the grids).
     """
     scene = Scene()
     default_type = next(iter(world.labware_types.values()))
