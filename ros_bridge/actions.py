@@ -197,9 +197,7 @@ class ActionCaller:
         answered: concurrent.futures.Future = concurrent.futures.Future()
 
         def ask_on_ros_thread() -> None:
-            nobodys_goal = ClientGoalHandle(self._client, UUID(uuid=list(uuid.uuid4().bytes)), None)
-            # rclpy offers cancel requests only through a goal handle; this one was never sent
-            request = self._client._cancel_goal_async(nobodys_goal)
+            request = cancel_nobodys_goal(self._client)
             request.add_done_callback(lambda done: _copy_ros_future(done, answered))
 
         self._runtime.call(ask_on_ros_thread)
@@ -263,6 +261,15 @@ class ActionCaller:
             goals = list(self._open_goals)
         for goal in goals:
             goal.abort(f"no answer can come: {reason}")
+
+
+def cancel_nobodys_goal(client: ActionClient) -> Any:
+    """Send a cancel request for a goal id nobody sent; returns its rclpy future. A live server whose
+    services have matched this client answers it ("unknown goal") and cancels nothing: the probe of
+    `ActionCaller.answers`. Call on the thread that spins the client's node."""
+    # rclpy offers cancel requests only through a goal handle; this one was never sent
+    nobodys_goal = ClientGoalHandle(client, UUID(uuid=list(uuid.uuid4().bytes)), None)
+    return client._cancel_goal_async(nobodys_goal)
 
 
 def _copy_ros_future(ros_future: Any, target: concurrent.futures.Future) -> None:

@@ -24,6 +24,8 @@ from rclpy.action import ActionClient
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
+from ros_bridge.actions import cancel_nobodys_goal
+
 REPO = Path(__file__).resolve().parents[2]
 
 
@@ -106,11 +108,23 @@ class RosCaller:
         )
 
     def action_client(self, action_type: Any, name: str, timeout_s: float = 30.0) -> ActionClient:
+        """A client of `name` once its server answers a request, not only once it is discovered: the
+        server may not yet know this client's reply readers then, and a goal's answer sent too
+        early is lost (test_sequencer_bounds waited 30 s for one, once, in a loaded CI run)."""
         if name not in self._action_clients:
             client = ActionClient(self.node, action_type, name)
-            self.wait_for(client.server_is_ready, timeout_s, f"action server {name}")
+            self.wait_for(
+                lambda: client.server_is_ready() and self._answers(client), timeout_s, f"action server {name}"
+            )
             self._action_clients[name] = client
         return self._action_clients[name]
+
+    def _answers(self, client: ActionClient) -> bool:
+        future = cancel_nobodys_goal(client)
+        self.executor.spin_until_future_complete(future, timeout_sec=1.0)
+        if not future.done():
+            client._remove_pending_cancel_request(future)  # an unanswered probe is withdrawn
+        return future.done()
 
     def send(self, action_type: Any, name: str, goal: Any, timeout_s: float = 30.0) -> Any:
         """Send a goal and return its handle once accepted or rejected."""

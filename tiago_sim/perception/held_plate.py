@@ -13,11 +13,18 @@ marker - the head unmoved since the marker was sighted, so the camera's error is
 and nest share the camera's error and their difference is free of it and of the arm's: what is
 left is the marker's and the nest's own mounting on the station, and the depth noise.
 
+The plate also hangs turned: the tool's heading carries the marker's heading error and the arm's,
+and the hotel's pocket lets it turn in the hand. Turned 0.74 deg and 1.5 mm across, a plate's corner
+stayed on a lead-in ramp of station_a/1 in the default lab (a CI run of test_examples; 1.44 deg in
+another run of it), so the turn is measured too and the place squares the plate to the nest.
+
 Method: depth pixels are back-projected into the nest's site frame (as the marker gave it); those
 at the plate top's height are the plate (the finger pads stand outside its long sides, the palm
-above it). The long side's ends give the centre along x; the short side's edges, read beyond the
-pads, give it along y. A plate whose measured extents do not match its type's (an end hidden by the
-arm, another body in the band) gives no measurement.
+above it). The turn comes from the straight edges (`_turn`); in the plate's own axes then, the long
+side's ends give the centre along x and the short side's edges, read beyond the pads, give it along
+y. A plate whose measured extents do not match its type's (an end hidden by the arm, another body
+in the band) gives no measurement; one whose ends are not two parallel lines gives its centre read
+in the nest's axes, no turn.
 
 Pure functions on arrays; safe on any thread.
 """
@@ -50,6 +57,15 @@ EXTENT_TOLERANCE_M = 0.005
 EDGE_PERCENTILE = 1.0  # per cent: extents from robust percentiles, symmetric so the centre is unbiased
 MIN_POINTS = 200
 MAX_TILT_RAD = math.radians(8.0)  # a top tilted further is not a plate held flat by its sides
+# The turn: each edge is read as its outermost pixel in bins this long along it (about three pixels
+# at 0.7 m), samples more than EDGE_FIT_BAND_M (about a pixel) off the fitted rectangle are dropped;
+# with fewer than MIN_EDGE_SHARE of them left, or fewer than MIN_EDGE_BINS along an end, no turn is
+# measured. A plate turned more than MAX_YAW_RAD is not believed.
+EDGE_BIN_M = 0.004
+EDGE_FIT_BAND_M = 0.0015
+MIN_EDGE_BINS = 8
+MIN_EDGE_SHARE = 0.7
+MAX_YAW_RAD = math.radians(6.0)
 
 
 @dataclass(frozen=True)
@@ -61,6 +77,12 @@ class HeldPlateSighting:
     length: float
     width: float
     points: int
+    yaw: float = 0.0  # its turn about the nest's z (rad), from its edges
+
+    @property
+    def pose(self) -> tuple[float, float, float]:
+        """(x, y, yaw) in the nest's plane."""
+        return (self.x, self.y, self.yaw)
 
 
 def site_points(depth_m: np.ndarray, intrinsics: CameraIntrinsics, T_site_optical: np.ndarray) -> np.ndarray:
@@ -111,6 +133,114 @@ def _top_plane(
     return lambda xs, ys: a + b * (xs - x0) + c * (ys - y0)
 
 
+@dataclass(frozen=True)
+class _Extents:
+    x: float
+    y: float
+    length: float
+    width: float
+    points: int
+    along: np.ndarray  # the top's pixels clear of the long sides (its ends' edges)
+    across: np.ndarray  # those beyond the pads and within the ends (its long edges)
+
+
+def _edge_samples(xs: np.ndarray, ys: np.ndarray, outer: float) -> tuple[np.ndarray, np.ndarray]:
+    """Points on one straight edge running along x: per bin along x, the bin's mean x and its
+    outermost y (``outer`` +1: largest, -1: smallest); bins of fewer than three pixels are skipped."""
+    if len(xs) == 0:
+        return np.empty(0), np.empty(0)
+    bins = np.floor((xs - xs.min()) / EDGE_BIN_M).astype(int)
+    centres, edges = [], []
+    for index in np.unique(bins):
+        chosen = bins == index
+        if chosen.sum() >= 3:
+            centres.append(float(xs[chosen].mean()))
+            edges.append(float(outer * np.max(outer * ys[chosen])))
+    return np.array(centres), np.array(edges)
+
+
+def _turn(extents: _Extents) -> float | None:
+    """The plate's turn about the nest's z from its edges, or None when its ends are not straight
+    lines of one rectangle (a stray body along an end, an end hidden).
+
+    A plate turned by yaw has its ends at x = c - tan(yaw) y and its long edges at y = c' + tan(yaw) x.
+    The ends are in full view between the long sides: a least-squares fit of tan(yaw) and their two
+    offsets, twice (samples more than a pixel off the first fit dropped). The long edges show only
+    beyond the pads, and the arm can hide a stretch of them (default lab, station_b: 25 mm of one cut
+    short by 22 mm); their samples within a pixel of the ends' fit join a last fit, for the long
+    baseline they give."""
+    edges = []
+    for points, along_x, outer, sign in (
+        (extents.along[extents.along[:, 0] > extents.x], 1, 1.0, -1.0),
+        (extents.along[extents.along[:, 0] < extents.x], 1, -1.0, -1.0),
+        (extents.across[extents.across[:, 1] > extents.y], 0, 1.0, 1.0),
+        (extents.across[extents.across[:, 1] < extents.y], 0, -1.0, 1.0),
+    ):
+        runs, values = _edge_samples(points[:, along_x], points[:, 1 - along_x], outer)
+        edges.append((sign * runs, values))
+    if min(len(edges[0][0]), len(edges[1][0])) < MIN_EDGE_BINS:
+        log.debug("held plate: its ends read in %d and %d bins, too few", len(edges[0][0]), len(edges[1][0]))
+        return None
+
+    def fit(chosen: list[tuple[np.ndarray, np.ndarray]]) -> tuple[float, list[np.ndarray]]:
+        """tan(yaw) through the samples of each edge (each its own offset); each edge's residuals."""
+        rows = [
+            np.column_stack([runs, *(np.full(len(runs), float(k == j)) for j in range(len(chosen)))])
+            for k, (runs, _values) in enumerate(chosen)
+        ]
+        solution = np.linalg.lstsq(np.vstack(rows), np.concatenate([v for _r, v in chosen]), rcond=None)[0]
+        return float(solution[0]), [v - row @ solution for row, (_r, v) in zip(rows, chosen, strict=True)]
+
+    slope, residuals = fit(edges[:2])
+    ends = [
+        (r[np.abs(e) < EDGE_FIT_BAND_M], v[np.abs(e) < EDGE_FIT_BAND_M])
+        for (r, v), e in zip(edges[:2], residuals, strict=True)
+    ]
+    share = sum(len(r) for r, _v in ends) / sum(len(r) for r, _v in edges[:2])
+    if share < MIN_EDGE_SHARE or min(len(r) for r, _v in ends) < MIN_EDGE_BINS // 2:
+        log.debug("held plate: %.0f %% of its ends' samples on two parallel lines, no turn", 100 * share)
+        return None
+    slope, _residuals = fit(ends)
+    chosen = list(ends)
+    for runs, values in edges[2:]:
+        if len(runs):
+            off = values - slope * runs
+            near = np.abs(off - np.median(off)) < EDGE_FIT_BAND_M
+            if near.sum() >= 2:
+                chosen.append((runs[near], values[near]))
+    slope, _residuals = fit(chosen)
+    return math.atan(slope)
+
+
+def _extents(on_top: np.ndarray, inner: np.ndarray, tool_x: float, pad_width: float) -> _Extents | None:
+    """Centre and size of the plate top from pixels in a frame whose x runs along its long side.
+    ``on_top``: the top's pixels (x, y); ``inner``: which of them lie clear of the long sides."""
+    along = on_top[inner]
+    if len(along) < MIN_POINTS:
+        log.debug("held plate: %d pixels along, too few", len(along))
+        return None
+    x_low, x_high = _extent(along[:, 0])
+    # The pads stand off the arm's tool position (joint readings) by the camera's calibration error
+    # against the arm's, and off the plate's centre by where the hand holds it: either can be several
+    # millimetres (random layout 99012: the pads seen 7 mm off the tool, their outer faces taken for
+    # the plate's edges, 95 mm wide). The pads lie within both spans, so both are left out.
+    pads_low = min(tool_x, (x_low + x_high) / 2) - pad_width / 2 - BEYOND_PADS_M
+    pads_high = max(tool_x, (x_low + x_high) / 2) + pad_width / 2 + BEYOND_PADS_M
+    beyond_pads = (on_top[:, 0] < pads_low) | (on_top[:, 0] > pads_high)
+    within_ends = (on_top[:, 0] > x_low + 0.004) & (on_top[:, 0] < x_high - 0.004)
+    across = on_top[beyond_pads & within_ends]
+    if len(across) < MIN_POINTS:
+        log.debug("held plate: %d pixels across, too few", len(across))
+        return None
+    y_low, y_high = _extent(across[:, 1])
+    # percentile extents fall short of the edges by about that share of the side on each end
+    trim = 1.0 - 2.0 * EDGE_PERCENTILE / 100.0
+    return _Extents(
+        (x_low + x_high) / 2, (y_low + y_high) / 2, (x_high - x_low) / trim, (y_high - y_low) / trim,
+        len(along), along, across,
+    )  # fmt: skip
+
+
 def locate_held_plate(
     points: np.ndarray,
     tool_in_site: np.ndarray,
@@ -127,6 +257,8 @@ def locate_held_plate(
     ``width``, ``height``: the plate type's outer size; ``pad_width``: the finger pads' width along
     the plate's long side (the robot model's), which hides the top face there. Percentile extents
     trim the same share at both ends, so the centre stays unbiased while a stray pixel cannot move it.
+    The turn comes first, from the four edges; the extents are then read in the plate's own axes (a
+    plate turned 1.5 deg reads 2 mm longer in the nest's).
     """
     tool_x, tool_y, tool_z = (float(v) for v in tool_in_site[:3])
     nominal_top = tool_z - plate_bottom_below_tool + height
@@ -142,30 +274,30 @@ def locate_held_plate(
     if top is None:
         return None
     on_top = near & (np.abs(points[:, 2] - top(points[:, 0], points[:, 1])) < TOP_BAND_M)
-    along = points[on_top & inner]
-    x_low, x_high = _extent(along[:, 0])
-    # The pads stand off the arm's tool position (joint readings) by the camera's calibration error
-    # against the arm's, and off the plate's centre by where the hand holds it: either can be several
-    # millimetres (random layout 99012: the pads seen 7 mm off the tool, their outer faces taken for
-    # the plate's edges, 95 mm wide). The pads lie within both spans, so both are left out.
-    pads_low = min(tool_x, (x_low + x_high) / 2) - pad_width / 2 - BEYOND_PADS_M
-    pads_high = max(tool_x, (x_low + x_high) / 2) + pad_width / 2 + BEYOND_PADS_M
-    beyond_pads = on_top & ((points[:, 0] < pads_low) | (points[:, 0] > pads_high))
-    within_ends = (points[:, 0] > x_low + 0.004) & (points[:, 0] < x_high - 0.004)
-    across = points[beyond_pads & within_ends]
-    if len(along) < MIN_POINTS or len(across) < MIN_POINTS:
-        log.debug("held plate: %d pixels along, %d across, too few", len(along), len(across))
+    top_xy = points[on_top][:, :2]
+    inner_on_top = inner[on_top]
+    first = _extents(top_xy, inner_on_top, tool_x, pad_width)
+    if first is None:
         return None
-    y_low, y_high = _extent(across[:, 1])
-    # percentile extents fall short of the edges by about that share of the side on each end
-    trim = 1.0 - 2.0 * EDGE_PERCENTILE / 100.0
-    sighting = HeldPlateSighting(
-        (x_low + x_high) / 2,
-        (y_low + y_high) / 2,
-        (x_high - x_low) / trim,
-        (y_high - y_low) / trim,
-        len(along),
-    )
+    yaw = _turn(first)
+    if yaw is None:  # the centre is still read, in the nest's axes, as before the turn was measured
+        log.info("held plate: its turn not measured, its centre read as if square to the nest")
+        yaw = 0.0
+    if abs(yaw) > MAX_YAW_RAD:
+        log.info("held plate: turned %.1f deg, more than a plate held by its sides", math.degrees(yaw))
+        return None
+    # the pixels turned by -yaw about the tool: x along the plate's long side again
+    pivot = np.array([tool_x, tool_y])
+    c, s = math.cos(yaw), math.sin(yaw)
+    unturn = np.array([[c, s], [-s, c]])  # rotation by -yaw (applied to row vectors as @ unturn.T)
+    turned = (top_xy - pivot) @ unturn.T + pivot
+    inner_turned = np.abs(turned[:, 1] - tool_y) < width / 2 - 0.008
+    final = _extents(turned, inner_turned, tool_x, pad_width)
+    if final is None:
+        return None
+    centre = np.array([final.x, final.y]) - pivot
+    x, y = (np.array([[c, -s], [s, c]]) @ centre) + pivot
+    sighting = HeldPlateSighting(float(x), float(y), final.length, final.width, final.points, yaw)
     if abs(sighting.length - length) > EXTENT_TOLERANCE_M or abs(sighting.width - width) > EXTENT_TOLERANCE_M:
         log.debug(
             "held plate: measured %.1f x %.1f mm, the plate is %.1f x %.1f mm: no measurement",

@@ -143,7 +143,7 @@ class MarkerMotionBehaviour:
         )
         if shift is None:
             return T_base_site
-        return T_base_site @ tf.make_transform((float(shift[0]), float(shift[1]), 0.0))
+        return T_base_site @ tf.from_planar(*shift)
 
     def _may_leave_the_line(self, run: ActionRun, arm: str, T_base_target: np.ndarray) -> bool:
         """Whether a move to the site's approach pose may go in joint space where no straight line has
