@@ -58,13 +58,12 @@ EDGE_PERCENTILE = 1.0  # per cent: extents from robust percentiles, symmetric so
 MIN_POINTS = 200
 MAX_TILT_RAD = math.radians(8.0)  # a top tilted further is not a plate held flat by its sides
 # The turn: each edge is read as its outermost pixel in bins this long along it (about three pixels
-# at 0.7 m), samples more than EDGE_FIT_BAND_M (about a pixel) off the fitted rectangle are dropped;
-# with fewer than MIN_EDGE_SHARE of them left, or fewer than MIN_EDGE_BINS along an end, no turn is
-# measured. A plate turned more than MAX_YAW_RAD is not believed.
+# at 0.7 m); an edge keeps its samples within EDGE_FIT_BAND_M (about a pixel) of its straightest
+# line; without an end straight over MIN_EDGE_BINS samples no turn is measured. A plate turned more
+# than MAX_YAW_RAD is not believed.
 EDGE_BIN_M = 0.004
 EDGE_FIT_BAND_M = 0.0015
 MIN_EDGE_BINS = 8
-MIN_EDGE_SHARE = 0.7
 MAX_YAW_RAD = math.radians(6.0)
 
 
@@ -159,57 +158,62 @@ def _edge_samples(xs: np.ndarray, ys: np.ndarray, outer: float) -> tuple[np.ndar
     return np.array(centres), np.array(edges)
 
 
+def _line_inliers(runs: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Which samples of one edge lie on its straightest stretch: the largest set within
+    EDGE_FIT_BAND_M of a line through two of them (every pair; an edge has a few dozen samples).
+    An arm link across an end cuts a corner off it, so half of its samples can lie off the line."""
+    best = np.zeros(len(runs), dtype=bool)
+    limit = math.tan(MAX_YAW_RAD)
+    for i in range(len(runs)):
+        for j in range(i + 1, len(runs)):
+            if abs(runs[j] - runs[i]) < 2 * EDGE_BIN_M:
+                continue
+            slope = (values[j] - values[i]) / (runs[j] - runs[i])
+            if abs(slope) > limit:
+                continue
+            near = np.abs(values - values[i] - slope * (runs - runs[i])) < EDGE_FIT_BAND_M
+            if near.sum() > best.sum():
+                best = near
+    return best
+
+
 def _turn(extents: _Extents) -> float | None:
-    """The plate's turn about the nest's z from its edges, or None when its ends are not straight
-    lines of one rectangle (a stray body along an end, an end hidden).
+    """The plate's turn about the nest's z from its edges, or None when no end shows a straight
+    stretch of MIN_EDGE_BINS samples.
 
     A plate turned by yaw has its ends at x = c - tan(yaw) y and its long edges at y = c' + tan(yaw) x.
-    The ends are in full view between the long sides: a least-squares fit of tan(yaw) and their two
-    offsets, twice (samples more than a pixel off the first fit dropped). The long edges show only
-    beyond the pads, and the arm can hide a stretch of them (default lab, station_b: 25 mm of one cut
-    short by 22 mm); their samples within a pixel of the ends' fit join a last fit, for the long
-    baseline they give."""
-    edges = []
-    for points, along_x, outer, sign in (
-        (extents.along[extents.along[:, 0] > extents.x], 1, 1.0, -1.0),
-        (extents.along[extents.along[:, 0] < extents.x], 1, -1.0, -1.0),
-        (extents.across[extents.across[:, 1] > extents.y], 0, 1.0, 1.0),
-        (extents.across[extents.across[:, 1] < extents.y], 0, -1.0, 1.0),
+    Each edge keeps its straightest stretch (`_line_inliers`): the ends are in full view between the
+    long sides unless an arm link crosses one (default lab, station_b/2: one end cut off diagonally
+    over half its width); the long edges show only beyond the pads, and the arm can hide part of
+    them (one long edge's stretch beyond the pads at one end read 22 mm short). tan(yaw) is then one
+    least-squares fit through all kept samples, each edge with its own offset."""
+    chosen = []
+    longest_end = 0
+    for k, (points, along_x, outer, sign) in enumerate(
+        (
+            (extents.along[extents.along[:, 0] > extents.x], 1, 1.0, -1.0),
+            (extents.along[extents.along[:, 0] < extents.x], 1, -1.0, -1.0),
+            (extents.across[extents.across[:, 1] > extents.y], 0, 1.0, 1.0),
+            (extents.across[extents.across[:, 1] < extents.y], 0, -1.0, 1.0),
+        )
     ):
         runs, values = _edge_samples(points[:, along_x], points[:, 1 - along_x], outer)
-        edges.append((sign * runs, values))
-    if min(len(edges[0][0]), len(edges[1][0])) < MIN_EDGE_BINS:
-        log.debug("held plate: its ends read in %d and %d bins, too few", len(edges[0][0]), len(edges[1][0]))
+        if len(runs) < 2:
+            continue
+        kept = _line_inliers(runs, values)
+        if k < 2:
+            longest_end = max(longest_end, int(kept.sum()))
+        if kept.sum() >= 2:
+            chosen.append((sign * runs[kept], values[kept]))
+    if longest_end < MIN_EDGE_BINS:
+        log.debug("held plate: no end straight over %d samples, no turn", MIN_EDGE_BINS)
         return None
-
-    def fit(chosen: list[tuple[np.ndarray, np.ndarray]]) -> tuple[float, list[np.ndarray]]:
-        """tan(yaw) through the samples of each edge (each its own offset); each edge's residuals."""
-        rows = [
-            np.column_stack([runs, *(np.full(len(runs), float(k == j)) for j in range(len(chosen)))])
-            for k, (runs, _values) in enumerate(chosen)
-        ]
-        solution = np.linalg.lstsq(np.vstack(rows), np.concatenate([v for _r, v in chosen]), rcond=None)[0]
-        return float(solution[0]), [v - row @ solution for row, (_r, v) in zip(rows, chosen, strict=True)]
-
-    slope, residuals = fit(edges[:2])
-    ends = [
-        (r[np.abs(e) < EDGE_FIT_BAND_M], v[np.abs(e) < EDGE_FIT_BAND_M])
-        for (r, v), e in zip(edges[:2], residuals, strict=True)
+    rows = [
+        np.column_stack([runs, *(np.full(len(runs), float(k == j)) for j in range(len(chosen)))])
+        for k, (runs, _values) in enumerate(chosen)
     ]
-    share = sum(len(r) for r, _v in ends) / sum(len(r) for r, _v in edges[:2])
-    if share < MIN_EDGE_SHARE or min(len(r) for r, _v in ends) < MIN_EDGE_BINS // 2:
-        log.debug("held plate: %.0f %% of its ends' samples on two parallel lines, no turn", 100 * share)
-        return None
-    slope, _residuals = fit(ends)
-    chosen = list(ends)
-    for runs, values in edges[2:]:
-        if len(runs):
-            off = values - slope * runs
-            near = np.abs(off - np.median(off)) < EDGE_FIT_BAND_M
-            if near.sum() >= 2:
-                chosen.append((runs[near], values[near]))
-    slope, _residuals = fit(chosen)
-    return math.atan(slope)
+    solution = np.linalg.lstsq(np.vstack(rows), np.concatenate([v for _r, v in chosen]), rcond=None)[0]
+    return math.atan(float(solution[0]))
 
 
 def _extents(on_top: np.ndarray, inner: np.ndarray, tool_x: float, pad_width: float) -> _Extents | None:

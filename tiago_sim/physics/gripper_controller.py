@@ -2,10 +2,16 @@
 
 Why: a microplate must be held by friction (16 N per finger, pads and plate at friction 1.0, as
 measured in the notes). Only after both pads touch the same plate does a fixed constraint
-"attach" it for travel; the constraint goes before the fingers open. The attach holds only what
-friction could: every step the plate's load is checked against the grip (grip_load), and a plate
-asked for more (too little grip force, a heavy plate, a knock) is let go of; from then on only the
-friction contacts of the still-closed fingers hold it, and it slips or falls as physics decides.
+"attach" it for travel. While it holds, the fingers press with HOLD_SQUEEZE_N only: the attach
+stands for the friction of the full grip force, and the full squeeze fighting the (soft) constraint
+moved the plate in the hand by up to 1 mm and 0.7 deg between the held-plate measurement above a
+nest and the release, and by up to 1.2 mm more while the pads opened (default lab, test_examples,
+read from the physics); a corner then met a lead-in ramp (CI). When the fingers open the attach
+stays until both pads have left the plate, as the geared fingers of a real gripper leave it
+together. The attach holds only what friction could: every step the plate's load is checked
+against the grip (grip_load), and a plate asked for more (too little grip force, a heavy plate, a
+knock) is let go of; from then on only the friction contacts of the still-closed fingers, pressing
+with the full grip force again, hold it, and it slips or falls as physics decides.
 Lives on the sim thread.
 """
 
@@ -28,6 +34,7 @@ STALL_SPEED = 0.002  # m/s: fingers count as stopped below this
 STALL_TIME_S = 0.15
 ATTACH_FORCE = 60.0  # N: the constraint's own limit; the grip check (grip_load) lets go far below it
 HOLDER_FRICTION = 0.15  # the hotel's polished lead-ins, as the station nests' (see scene.NEST_FRICTION)
+HOLD_SQUEEZE_N = 2.0  # per finger while attached (the attach stands for the grip force's friction)
 GEAR_FORCE = 5.0  # N: keeps the fingers in step in free motion, yields so both pads reach an off-centre plate
 
 
@@ -74,9 +81,11 @@ class Gripper:
         p.changeConstraint(gear, gearRatio=-1, maxForce=GEAR_FORCE, erp=0.2, physicsClientId=client)
         self.command(rm.FINGER_TRAVEL)
 
-    def command(self, finger_position: float) -> None:
+    def command(self, finger_position: float, force_n: float | None = None) -> None:
+        """Fingers to ``finger_position`` with ``force_n`` each (default: the grip force)."""
+        force = self.grip_force_n if force_n is None else force_n
         self.body.command_positions(
-            {name: finger_position for name in self.fingers}, force_scale=self.grip_force_n / rm.FINGER_EFFORT
+            {name: finger_position for name in self.fingers}, force_scale=force / rm.FINGER_EFFORT
         )
 
     def opening(self) -> float:
@@ -100,12 +109,29 @@ class Gripper:
         plate = self.plate_bodies[labware_id]
         self.attach_constraint = self.body.fix_to_link(self.palm_link, plate, ATTACH_FORCE)
         self.attached_id = labware_id
+        self.command(0.0, HOLD_SQUEEZE_N)
         self._grip_monitor = GripLoadMonitor(
             self.body.client, self.body.id, plate, self.finger_links, self.grip_force_n
         )
 
+    def pads_clear_of(self, labware_id: str) -> bool:
+        """Neither pad touches the plate (the opening fingers have left it)."""
+        plate = self.plate_bodies[labware_id]
+        client = self.body.client
+        return not any(
+            p.getContactPoints(self.body.id, plate, link, -1, physicsClientId=client)
+            for link in self.finger_links
+        )
+
+    def start_release(self) -> None:
+        """The fingers are about to open: the grip check ends (their force no longer holds the plate by
+        design), the attach stays until the pads have left the plate (`GripperMotion`)."""
+        self._grip_monitor = None
+        self.slipped_id = ""
+
     def detach(self) -> None:
-        """Remove the attach (before the fingers open, or when the grip cannot hold the plate)."""
+        """Remove the attach (once the opening pads have left the plate, or when the grip cannot hold
+        it)."""
         if self.attach_constraint is not None:
             p.removeConstraint(self.attach_constraint, physicsClientId=self.body.client)
         self.attach_constraint = None
@@ -121,6 +147,7 @@ class Gripper:
             log.warning("%s gripper: %s slips: %s", self.side, self.attached_id, load.describe())
             self.slipped_id, self.last_slip = self.attached_id, load
             self.detach()
+            self.command(0.0)  # friction alone holds it now: the full squeeze
         return load
 
     def loose(self) -> bool:
@@ -143,8 +170,7 @@ class GripperMotion(Motion):
         self.history: list[list[float]] = []
         self.phase = "closing" if close else "opening"
         if not close:
-            gripper.detach()
-            gripper.slipped_id = ""
+            gripper.start_release()
         gripper.command(0.0 if close else rm.FINGER_TRAVEL)
         self.remaining_s = rm.FINGER_TRAVEL / rm.FINGER_SPEED + 0.3
 
@@ -154,8 +180,12 @@ class GripperMotion(Motion):
         if self.cancel_requested:
             joints = gripper.body.joint_positions()
             gripper.body.command_positions({n: joints[n] for n in gripper.fingers})
+            if not self.close:
+                gripper.detach()  # the fingers began to open: friction contacts decide from here
             self.finish(False, CANCELED, "canceled")
             return
+        if not self.close and gripper.attached_id and gripper.pads_clear_of(gripper.attached_id):
+            gripper.detach()  # the plate leaves both pads at once, as from a real gripper's geared fingers
         target = 0.0 if self.close else rm.FINGER_TRAVEL
         remaining = abs(sum(gripper.body.joint_positions()[n] for n in gripper.fingers) / 2 - target)
         self.progress = float(min(0.99, 1.0 - remaining / rm.FINGER_TRAVEL))
@@ -174,6 +204,8 @@ class GripperMotion(Motion):
             self.elapsed_s > rm.FINGER_TRAVEL / rm.FINGER_SPEED + 1.0
         )  # fingers pressing but jittering
         if remaining < 5e-4 or self.stall_s > 0.0 or timed_out:
+            if not self.close:
+                gripper.detach()  # open: nothing is held, whatever the contacts say
             if self.close:
                 labware_id = gripper.touching()
                 self.holding = bool(labware_id) and self.opening_m > 2 * rm.FINGER_MOUNT_OFFSET + 0.002
