@@ -182,38 +182,48 @@ def _turn(extents: _Extents) -> float | None:
     stretch of MIN_EDGE_BINS samples.
 
     A plate turned by yaw has its ends at x = c - tan(yaw) y and its long edges at y = c' + tan(yaw) x.
-    Each edge keeps its straightest stretch (`_line_inliers`): the ends are in full view between the
-    long sides unless an arm link crosses one (default lab, station_b/2: one end cut off diagonally
-    over half its width); the long edges show only beyond the pads, and the arm can hide part of
-    them (one long edge's stretch beyond the pads at one end read 22 mm short). tan(yaw) is then one
-    least-squares fit through all kept samples, each edge with its own offset."""
-    chosen = []
-    longest_end = 0
-    for k, (points, along_x, outer, sign) in enumerate(
-        (
-            (extents.along[extents.along[:, 0] > extents.x], 1, 1.0, -1.0),
-            (extents.along[extents.along[:, 0] < extents.x], 1, -1.0, -1.0),
-            (extents.across[extents.across[:, 1] > extents.y], 0, 1.0, 1.0),
-            (extents.across[extents.across[:, 1] < extents.y], 0, -1.0, 1.0),
-        )
+    The ends are in full view between the long sides unless an arm link crosses one (default lab,
+    station_b/2: one end cut off diagonally over half its width), so each keeps its straightest
+    stretch (`_line_inliers`) and a first fit takes tan(yaw) from them. The long edges show only
+    beyond the pads, in two short stretches, and the arm can hide one (a stretch read 22 mm short);
+    their samples on a line of that slope (the offset that keeps the most within a pixel) join the
+    last fit for the long baseline they give. Each edge has its own offset in both fits."""
+    ends, sides = [], []
+    for points, along_x, outer, sign, kind in (
+        (extents.along[extents.along[:, 0] > extents.x], 1, 1.0, -1.0, ends),
+        (extents.along[extents.along[:, 0] < extents.x], 1, -1.0, -1.0, ends),
+        (extents.across[extents.across[:, 1] > extents.y], 0, 1.0, 1.0, sides),
+        (extents.across[extents.across[:, 1] < extents.y], 0, -1.0, 1.0, sides),
     ):
         runs, values = _edge_samples(points[:, along_x], points[:, 1 - along_x], outer)
-        if len(runs) < 2:
-            continue
-        kept = _line_inliers(runs, values)
-        if k < 2:
-            longest_end = max(longest_end, int(kept.sum()))
-        if kept.sum() >= 2:
-            chosen.append((sign * runs[kept], values[kept]))
-    if longest_end < MIN_EDGE_BINS:
+        kind.append((sign * runs, values))
+    ends = [
+        (runs[kept], values[kept])
+        for runs, values in ends
+        if (kept := _line_inliers(runs, values)).sum() >= 2
+    ]
+    if max((len(runs) for runs, _values in ends), default=0) < MIN_EDGE_BINS:
         log.debug("held plate: no end straight over %d samples, no turn", MIN_EDGE_BINS)
         return None
+    slope = _common_slope(ends)
+    chosen = list(ends)
+    for runs, values in sides:
+        offsets = values - slope * runs
+        counts = [int((np.abs(offsets - offset) < EDGE_FIT_BAND_M).sum()) for offset in offsets]
+        if counts and max(counts) >= 2:
+            near = np.abs(offsets - offsets[int(np.argmax(counts))]) < EDGE_FIT_BAND_M
+            chosen.append((runs[near], values[near]))
+    return math.atan(_common_slope(chosen))
+
+
+def _common_slope(edges: list[tuple[np.ndarray, np.ndarray]]) -> float:
+    """The least-squares slope shared by straight edges, each with its own offset."""
     rows = [
-        np.column_stack([runs, *(np.full(len(runs), float(k == j)) for j in range(len(chosen)))])
-        for k, (runs, _values) in enumerate(chosen)
+        np.column_stack([runs, *(np.full(len(runs), float(k == j)) for j in range(len(edges)))])
+        for k, (runs, _values) in enumerate(edges)
     ]
-    solution = np.linalg.lstsq(np.vstack(rows), np.concatenate([v for _r, v in chosen]), rcond=None)[0]
-    return math.atan(float(solution[0]))
+    solution = np.linalg.lstsq(np.vstack(rows), np.concatenate([v for _r, v in edges]), rcond=None)[0]
+    return float(solution[0])
 
 
 def _extents(on_top: np.ndarray, inner: np.ndarray, tool_x: float, pad_width: float) -> _Extents | None:

@@ -43,6 +43,7 @@ def _render(
     hide_left_end: bool = False,
     tilt_deg: float = 0.0,
     yaw_deg: float = 0.0,
+    cut_corner: bool = False,
 ):
     """Depth image of the scene and T_world_optical; tool and plate offsets in the site frame (m)."""
     client = p.connect(p.DIRECT)
@@ -63,6 +64,9 @@ def _render(
         if hide_left_end:  # an arm link between the camera and the plate's +x end
             hider = (PLATE.length / 2 - 0.005, -0.025, bottom + 0.04)
             _box(client, (0.05, 0.15, 0.02), T_WORLD_SITE @ tf.make_transform(hider), (0.3, 0.3, 0.3, 1))
+        if cut_corner:  # an arm link across the +x end at 45 deg, hiding a corner of it
+            link = tf.from_xyz_rpy((PLATE.length / 2 - 0.005, 0.025, bottom + 0.04), (0.0, 0.0, np.pi / 4))
+            _box(client, (0.07, 0.02, 0.015), T_WORLD_SITE @ link, (0.3, 0.3, 0.3, 1))
         T_world_optical = optical_frame_looking_at(EYE, T_WORLD_SITE[:3, 3] + [0.0, 0.0, 0.1])
         _rgb, depth = render_rgbd(client, T_world_optical, CameraIntrinsics())
         return depth, T_world_optical
@@ -105,6 +109,21 @@ def test_a_plate_turned_in_the_hand_is_found_with_its_turn(plate_xy, yaw_deg):
     assert abs(np.degrees(sighting.yaw) - yaw_deg) < 0.5
     assert abs(sighting.x - plate_xy[0]) < 0.001
     assert abs(sighting.y - plate_xy[1]) < 0.001
+
+
+@pytest.mark.parametrize("yaw_deg", [-1.7, 1.2])
+def test_the_turn_is_read_with_a_corner_of_the_plate_hidden(yaw_deg: float):
+    """Default lab, station_b/2: an arm link crossed one end of the held plate diagonally, the ends
+    were not two parallel lines, and the plate went down 1.2 deg turned, unmeasured. Each edge's
+    straightest stretch still gives the turn."""
+    depth, T_world_optical = _render((0.002, 0.001), (0.002, 0.001), yaw_deg=yaw_deg, cut_corner=True)
+    points = site_points(depth, CameraIntrinsics(), tf.invert(T_WORLD_SITE) @ T_world_optical)
+    tool = np.array([0.002, 0.001, APPROACH + GRASP_HEIGHT])
+    sighting = locate_held_plate(
+        points, tool, GRASP_HEIGHT, PLATE.length, PLATE.width, PLATE.height, PAD_WIDTH
+    )
+    assert sighting is not None
+    assert abs(np.degrees(sighting.yaw) - yaw_deg) < 0.5
 
 
 @pytest.mark.parametrize("tilt_deg", [-4.0, 2.0, 4.0])

@@ -307,3 +307,38 @@ def test_the_nest_sensor_sees_a_seated_plate_and_not_one_on_a_lead_in_rim():
         assert NestReading(nest, False, "") in sim.nest_readings()
     finally:
         sim.close()
+
+
+def _planar_in(T_reference: np.ndarray, T: np.ndarray) -> np.ndarray:
+    """(x, y in mm, yaw in deg) of ``T`` in the frame ``T_reference``."""
+    relative = tf.invert(T_reference) @ T
+    return np.array([*(1000 * relative[:2, 3]), np.degrees(tf.yaw_of(relative))])
+
+
+def test_a_held_plate_stays_where_the_hand_holds_it_and_is_let_go_of_where_it_hangs():
+    """The place correction measures the held plate above the nest and moves the tool by what it
+    sees, so the plate must not move in the hand after that nor at the release. Read from the
+    physics in test_examples: with the full grip force squeezing against the travel attach, and the
+    attach let go of while the pads still squeezed, the plate moved by up to 1 mm and 0.7 deg in the
+    hand between the measurement and the release and up to 1.2 mm more as the pads opened."""
+    sim, script, T_base_site = _tool_above_station_a(APPROACH)
+    try:
+        script.run(sim.move_tool(ARM, script.grasp(T_base_site)), "descend")
+        script.run(sim.gripper(ARM, close=True), "close")
+        script.run(sim.move_tool(ARM, script.grasp(T_base_site, CARRY)), "lift")
+        script.run(sim.move_tool(ARM, script.grasp(T_base_site, APPROACH)), "over the nest")
+        measured = script.plate_in_grasp()  # where the measurement would see it
+        script.run(sim.move_tool(ARM, script.grasp(T_base_site, 0.006)), "lower")
+        lowered = script.plate_in_grasp()
+        hanging = sim.plate_bottom_pose(PLATE)
+        opening = sim.gripper(ARM, close=False)
+        while not sim.grippers[ARM].pads_clear_of(PLATE):  # until the pads have left the plate
+            assert not opening.done, "the fingers opened fully without leaving the plate"
+            sim.step()
+        let_go = _planar_in(hanging, sim.plate_bottom_pose(PLATE))
+        moved_in_hand = _planar_in(measured, lowered)
+        assert np.all(np.abs(moved_in_hand[:2]) < 0.2) and abs(moved_in_hand[2]) < 0.1, moved_in_hand
+        assert np.all(np.abs(let_go[:2]) < 0.2) and abs(let_go[2]) < 0.1, let_go
+        script.run(opening, "open")
+    finally:
+        sim.close()
