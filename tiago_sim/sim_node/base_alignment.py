@@ -35,6 +35,9 @@ HEAD_JOINTS = ("head_1_joint", "head_2_joint")
 # rad; the camera sees 63 deg across. The second look repeats the first once the torso stands.
 SEARCH_PAN_OFFSETS = (0.0, 0.0, 0.45, -0.45, 0.9, -0.9)
 ALIGN_SPEED = 0.3  # m/s cap for the short final drive (the acceleration limit keeps it lower anyway)
+# How far a nest must lie on the working arm's side of the base's centre line (the calibration and
+# approach errors moved nests up to 1.6 cm across it).
+ARM_SIDE_MARGIN_M = 0.03
 
 
 def planar(transform: np.ndarray) -> tuple[float, float, float]:
@@ -72,17 +75,41 @@ def _search(run: ActionRun, kinematics: RobotKinematics, target: np.ndarray, loo
     raise failure
 
 
+def working_pose(station: Station, sub_position: int, arm: str) -> np.ndarray:
+    """T_world_base where the robot works at nest ``sub_position``: the station's working pose, moved
+    sideways along the bench where the nest would lie less than ARM_SIDE_MARGIN_M on the working
+    arm's side of the base's centre line.
+
+    Why: the right arm reaches a nest top-down from 0 to 0.45 m right of the base
+    (tiago_sim.layouts.station_draw), and a row's end may lie at that band's edge; the calibration
+    errors then put it a centimetre beyond, and the arm could not reach it (IK_FAILED at nests
+    0.7 to 1.6 cm left of the base, 0.78 to 0.84 m high: random layouts 98147, 101047, 101069,
+    101115, which failed the same way before this session's changes)."""
+    T_world_work = station.aligned_pose().matrix()
+    side = -1.0 if arm == "right" else 1.0  # the working arm's side of the base, along its y
+    inward = side * float((tf.invert(T_world_work) @ station.T_world_site(sub_position))[1, 3])
+    if inward >= ARM_SIDE_MARGIN_M:
+        return T_world_work
+    log.info(
+        "nest %d of %s lies %.3f m on the %s arm's side: working %.3f m further %s",
+        sub_position, station.name, inward, arm, ARM_SIDE_MARGIN_M - inward, "left" if side < 0 else "right",
+    )  # fmt: skip
+    return T_world_work @ tf.from_planar(0.0, side * (inward - ARM_SIDE_MARGIN_M), 0.0)
+
+
 def align_base(
     run: ActionRun,
     station: Station,
     kinematics: RobotKinematics,
     look: Any,
     working_joints: dict[str, float],
+    T_world_work: np.ndarray,
 ) -> Any:
     """Look at the marker, drive to the working pose it implies, look again; returns the last sighting.
 
     `look(run)` takes an image and returns the marker sighting (T_base_marker); `working_joints`
-    are torso/head targets that move while the base drives (e.g. the bench working posture).
+    are torso/head targets that move while the base drives (e.g. the bench working posture);
+    `T_world_work` is the nominal working pose (`working_pose`).
     """
     # Where the base believes it stands (localisation), not the POI: a task may start where the
     # last one ended, at the working pose 0.22 m nearer.
@@ -95,7 +122,7 @@ def align_base(
     background = [lifting]  # motions running beside the ones this goal follows
     try:
         sighting = _search(run, kinematics, T_base_marker_expected[:3, 3], look, lifting)
-        T_marker_work = tf.invert(station.T_world_marker()) @ station.aligned_pose().matrix()
+        T_marker_work = tf.invert(station.T_world_marker()) @ T_world_work
         correction = planar(sighting.T_base_marker @ T_marker_work)  # working pose in base_footprint
         # The goal is fixed in the odometry frame (where the base stood at the sighting) and put
         # into the map frame the drive closes its loop in at the instant the drive starts; the

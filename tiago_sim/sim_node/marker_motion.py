@@ -36,7 +36,7 @@ from tiago_sim.perception.site_frames import nest_in_base
 from tiago_sim.robot.kinematics import RobotKinematics
 from tiago_sim.robot.motion_library import HotelGrasp
 from tiago_sim.sim_node.action_run import ActionAbort, ActionRun
-from tiago_sim.sim_node.base_alignment import align_base
+from tiago_sim.sim_node.base_alignment import align_base, working_pose
 from tiago_sim.sim_node.behaviours import TOOL_SPEED_FREE, TOOL_SPEED_INTO_POCKET, RobotBehaviours
 from tiago_sim.sim_node.place_correction import place_shift
 
@@ -177,8 +177,9 @@ class MarkerMotionBehaviour:
         if goal.target == "work_pose":  # final approach of the base, guided by the marker
             bench = self.behaviours.motions.frames_for("Benchtop", arm)[0]
             posture = {name: value for name, value in bench.items() if not name.startswith("arm_")}
+            T_world_work = working_pose(station, sub_position, arm)
             sighting = align_base(
-                run, station, self.kinematics, lambda r: self.look(r, station.name), posture
+                run, station, self.kinematics, lambda r: self.look(r, station.name), posture, T_world_work
             )
             return {"marker_in_base": pose_msg(sighting.T_base_marker)}
         sighting = self._cached(run, station.name)

@@ -23,7 +23,7 @@ from tiago_sim import transforms as tf
 from tiago_sim.lab.world import load_world
 from tiago_sim.physics.simulation import Simulation
 from tiago_sim.robot.kinematics import RobotKinematics
-from tiago_sim.sim_node.base_alignment import head_angles_towards, planar
+from tiago_sim.sim_node.base_alignment import ARM_SIDE_MARGIN_M, head_angles_towards, planar, working_pose
 from tiago_sim.transforms import compose_planar
 
 PLATE = "plate_001"
@@ -110,3 +110,25 @@ def test_a_plate_released_off_centre_slides_into_the_hotel_pocket(offset):
         assert sim.hotel_readings()[0].labware_id == PLATE
     finally:
         sim.close()
+
+
+def _inward(T_world_base: np.ndarray, station, sub_position: int) -> float:
+    """How far a nest lies right of the base's centre line (the right arm's side), in m."""
+    return -float((tf.invert(T_world_base) @ station.T_world_site(sub_position))[1, 3])
+
+
+def test_a_nest_on_the_centre_line_is_worked_at_from_a_pose_moved_to_keep_it_on_the_arms_side():
+    """Random layouts 98147, 101047, 101069 and 101115: a row's end nest lay on the base's centre line
+    (the edge of the right arm's band); with the calibration errors it came to lie a centimetre left
+    of it and the arm could not reach it (IK_FAILED). The working pose for such a nest moves left
+    until the nest lies ARM_SIDE_MARGIN_M right of the centre line; the others keep the station's."""
+    station = load_world().station("station_a")
+    nominal = station.aligned_pose().matrix()
+    assert _inward(nominal, station, 1) > ARM_SIDE_MARGIN_M  # the default lab: nothing moves
+    np.testing.assert_allclose(working_pose(station, 1, "right"), nominal)
+    on_line = dataclasses.replace(station, lateral=station.lateral - _inward(nominal, station, 1))
+    assert _inward(on_line.aligned_pose().matrix(), on_line, 1) == pytest.approx(0.0, abs=1e-9)
+    moved = working_pose(on_line, 1, "right")
+    assert _inward(moved, on_line, 1) == pytest.approx(ARM_SIDE_MARGIN_M, abs=1e-9)
+    np.testing.assert_allclose(moved[:3, :3], on_line.aligned_pose().matrix()[:3, :3])  # sideways only
+    np.testing.assert_allclose(working_pose(on_line, 2, "right"), on_line.aligned_pose().matrix())
