@@ -15,6 +15,7 @@ import random
 from typing import Any
 
 from tiago_sim.lab.serviceability import WORKING_CLEARANCE
+from tiago_sim.robot import robot_model as rm
 
 RANGES: dict[str, Any] = {
     "stations": (2, 6),
@@ -24,7 +25,7 @@ RANGES: dict[str, Any] = {
     "bench_width_beyond_row": (0.35, 0.90),  # m, bench width minus the nest row's length
     "nests": (1, 4),
     "spacing": (0.15, 0.20),  # m between nests; at most 0.45 m / (nests - 1): the right arm's band
-    "reach_band": 0.45,  # m, right of the base, where every nest must lie
+    "reach_band": rm.TOP_DOWN_REACH_BAND_M,  # m, right of the base, where every nest must lie
     "marker_size": (0.10, 0.14),  # m
     "marker_from_front_edge": (0.20, 0.30),  # m, bench front edge to marker
     "marker_above_top": (0.02, 0.08),  # m, the marker's lower edge above the bench top

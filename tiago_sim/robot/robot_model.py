@@ -53,6 +53,10 @@ FINGER_SPEED = 0.05
 FINGER_EFFORT = 16.0
 PAD_THICKNESS = 0.010
 PAD_WIDTH = 0.080  # along grasping-frame z (along the plate's long side)
+# An arm reaches a nest top-down (grasp and approach, torso free) from 0 to this far to its side of
+# the base's centre line, from a working pose 0.45 to 0.55 m in front of the nests, for nests 0.55
+# to 0.80 m high (measured with this model's IK: tiago_sim.layouts.station_draw).
+TOP_DOWN_REACH_BAND_M = 0.45
 PAD_TIP = 0.005  # pad reaches this far past the grasping frame along x
 PAD_LENGTH = 0.035  # along grasping-frame x
 TOOL_TO_GRASP = 0.1506 + 0.12

@@ -26,6 +26,7 @@ from labware_interfaces.msg import ErrorCodes
 
 from tiago_sim import transforms as tf
 from tiago_sim.lab.world import Station
+from tiago_sim.robot import robot_model as rm
 from tiago_sim.robot.kinematics import RobotKinematics, head_angles_towards
 from tiago_sim.sim_node.action_run import ActionAbort, ActionRun
 
@@ -35,8 +36,8 @@ HEAD_JOINTS = ("head_1_joint", "head_2_joint")
 # rad; the camera sees 63 deg across. The second look repeats the first once the torso stands.
 SEARCH_PAN_OFFSETS = (0.0, 0.0, 0.45, -0.45, 0.9, -0.9)
 ALIGN_SPEED = 0.3  # m/s cap for the short final drive (the acceleration limit keeps it lower anyway)
-# How far a nest must lie on the working arm's side of the base's centre line (the calibration and
-# approach errors moved nests up to 1.6 cm across it).
+# How far inside the working arm's band a nest must lie (the calibration and approach errors moved
+# nests up to 1.6 cm across its edge).
 ARM_SIDE_MARGIN_M = 0.03
 
 
@@ -77,24 +78,27 @@ def _search(run: ActionRun, kinematics: RobotKinematics, target: np.ndarray, loo
 
 def working_pose(station: Station, sub_position: int, arm: str) -> np.ndarray:
     """T_world_base where the robot works at nest ``sub_position``: the station's working pose, moved
-    sideways along the bench where the nest would lie less than ARM_SIDE_MARGIN_M on the working
-    arm's side of the base's centre line.
+    sideways along the bench where the nest would lie less than ARM_SIDE_MARGIN_M inside the working
+    arm's band (0 to TOP_DOWN_REACH_BAND_M on its side of the base's centre line).
 
-    Why: the right arm reaches a nest top-down from 0 to 0.45 m right of the base
-    (tiago_sim.layouts.station_draw), and a row's end may lie at that band's edge; the calibration
-    errors then put it a centimetre beyond, and the arm could not reach it (IK_FAILED at nests
-    0.7 to 1.6 cm left of the base, 0.78 to 0.84 m high: random layouts 98147, 101047, 101069,
-    101115, which failed the same way before this session's changes)."""
+    Why: a row may span the whole band, its end nests on the band's edges, and the calibration
+    errors then put one a centimetre beyond: the arm could not reach a nest 0.7 to 1.6 cm left of
+    the centre line, 0.78 to 0.84 m high (IK_FAILED: random layouts 98147, 101047, 101069, 101115),
+    and at the far end, 0.45 m right, the fingers closed on a plate pressed into its nest by 45 to
+    82 N and the grip let go of it (PLATE_SLIPPED: 102011, 102031). All six failed the same way
+    before this session's changes."""
     T_world_work = station.aligned_pose().matrix()
     side = -1.0 if arm == "right" else 1.0  # the working arm's side of the base, along its y
     inward = side * float((tf.invert(T_world_work) @ station.T_world_site(sub_position))[1, 3])
-    if inward >= ARM_SIDE_MARGIN_M:
+    wanted = min(max(inward, ARM_SIDE_MARGIN_M), rm.TOP_DOWN_REACH_BAND_M - ARM_SIDE_MARGIN_M)
+    if wanted == inward:
         return T_world_work
     log.info(
-        "nest %d of %s lies %.3f m on the %s arm's side: working %.3f m further %s",
-        sub_position, station.name, inward, arm, ARM_SIDE_MARGIN_M - inward, "left" if side < 0 else "right",
+        "nest %d of %s lies %.3f m to the %s arm's side: working from %.3f m further %s",
+        sub_position, station.name, inward, arm, abs(wanted - inward),
+        "left" if side * (wanted - inward) < 0 else "right",
     )  # fmt: skip
-    return T_world_work @ tf.from_planar(0.0, side * (inward - ARM_SIDE_MARGIN_M), 0.0)
+    return T_world_work @ tf.from_planar(0.0, side * (inward - wanted), 0.0)
 
 
 def align_base(

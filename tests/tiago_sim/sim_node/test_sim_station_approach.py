@@ -23,6 +23,7 @@ from tiago_sim import transforms as tf
 from tiago_sim.lab.world import load_world
 from tiago_sim.physics.simulation import Simulation
 from tiago_sim.robot.kinematics import RobotKinematics
+from tiago_sim.robot.robot_model import TOP_DOWN_REACH_BAND_M
 from tiago_sim.sim_node.base_alignment import ARM_SIDE_MARGIN_M, head_angles_towards, planar, working_pose
 from tiago_sim.transforms import compose_planar
 
@@ -117,11 +118,13 @@ def _inward(T_world_base: np.ndarray, station, sub_position: int) -> float:
     return -float((tf.invert(T_world_base) @ station.T_world_site(sub_position))[1, 3])
 
 
-def test_a_nest_on_the_centre_line_is_worked_at_from_a_pose_moved_to_keep_it_on_the_arms_side():
+def test_a_nest_on_an_edge_of_the_arms_band_is_worked_at_from_a_pose_moved_to_keep_it_inside():
     """Random layouts 98147, 101047, 101069 and 101115: a row's end nest lay on the base's centre line
     (the edge of the right arm's band); with the calibration errors it came to lie a centimetre left
-    of it and the arm could not reach it (IK_FAILED). The working pose for such a nest moves left
-    until the nest lies ARM_SIDE_MARGIN_M right of the centre line; the others keep the station's."""
+    of it and the arm could not reach it (IK_FAILED); 102011 and 102031: at the band's far edge the
+    plate was pressed into its nest at the grasp and the grip let go of it. The working pose for such
+    a nest moves sideways until the nest lies ARM_SIDE_MARGIN_M inside the band; the others keep the
+    station's."""
     station = load_world().station("station_a")
     nominal = station.aligned_pose().matrix()
     assert _inward(nominal, station, 1) > ARM_SIDE_MARGIN_M  # the default lab: nothing moves
@@ -132,3 +135,6 @@ def test_a_nest_on_the_centre_line_is_worked_at_from_a_pose_moved_to_keep_it_on_
     assert _inward(moved, on_line, 1) == pytest.approx(ARM_SIDE_MARGIN_M, abs=1e-9)
     np.testing.assert_allclose(moved[:3, :3], on_line.aligned_pose().matrix()[:3, :3])  # sideways only
     np.testing.assert_allclose(working_pose(on_line, 2, "right"), on_line.aligned_pose().matrix())
+    far_end = dataclasses.replace(station, lateral=on_line.lateral + TOP_DOWN_REACH_BAND_M)  # 0.45 m right
+    moved = working_pose(far_end, 1, "right")
+    assert _inward(moved, far_end, 1) == pytest.approx(TOP_DOWN_REACH_BAND_M - ARM_SIDE_MARGIN_M, abs=1e-9)
