@@ -15,7 +15,7 @@ import pytest
 from labware_model.labware import LabwareType
 from tiago_sim import transforms as tf
 from tiago_sim.perception.camera import CameraIntrinsics, optical_frame_looking_at, render_rgbd
-from tiago_sim.perception.held_plate import locate_held_plate, site_points
+from tiago_sim.perception.held_plate import HeldPlateSighting, locate_held_plate, site_points
 from tiago_sim.robot.motion_library import HotelGrasp
 from tiago_sim.robot.robot_model import PAD_WIDTH
 from tiago_sim.sim_node.behaviours import FLIP_ABOUT_APPROACH
@@ -91,6 +91,21 @@ def _assert_found_within_a_millimetre(plate_xy, tool_xy, tilt_deg: float = 0.0) 
     assert abs(sighting.y - plate_xy[1]) < 0.001
 
 
+def _sighting_held_at(
+    plate_xy: tuple[float, float], yaw_deg: float, cut_corner: bool = False
+) -> HeldPlateSighting:
+    """The plate found with the tool at (2, 1) mm from the site, the plate at ``plate_xy`` turned."""
+    tool_xy = (0.002, 0.001)
+    depth, T_world_optical = _render(plate_xy, tool_xy, yaw_deg=yaw_deg, cut_corner=cut_corner)
+    points = site_points(depth, CameraIntrinsics(), tf.invert(T_WORLD_SITE) @ T_world_optical)
+    tool = np.array([*tool_xy, APPROACH + GRASP_HEIGHT])
+    sighting = locate_held_plate(
+        points, tool, GRASP_HEIGHT, PLATE.length, PLATE.width, PLATE.height, PAD_WIDTH
+    )
+    assert sighting is not None
+    return sighting
+
+
 @pytest.mark.parametrize(
     ("plate_xy", "yaw_deg"), [((0.002, 0.001), 1.0), ((0.004, -0.002), -1.5), ((0.0, 0.0), 3.0)]
 )
@@ -99,13 +114,7 @@ def test_a_plate_turned_in_the_hand_is_found_with_its_turn(plate_xy, yaw_deg):
     test_examples, 0.74 deg with 1.5 mm across in a failed CI run: a corner left on a lead-in). Its
     turn is read within 0.5 deg (0.22 deg RMS over 28 poses of plate and tool: the edges' pixels are
     1.3 mm apart at 0.7 m), its centre still within 1 mm."""
-    depth, T_world_optical = _render(plate_xy, (0.002, 0.001), yaw_deg=yaw_deg)
-    points = site_points(depth, CameraIntrinsics(), tf.invert(T_WORLD_SITE) @ T_world_optical)
-    tool = np.array([0.002, 0.001, APPROACH + GRASP_HEIGHT])
-    sighting = locate_held_plate(
-        points, tool, GRASP_HEIGHT, PLATE.length, PLATE.width, PLATE.height, PAD_WIDTH
-    )
-    assert sighting is not None
+    sighting = _sighting_held_at(plate_xy, yaw_deg)
     assert abs(np.degrees(sighting.yaw) - yaw_deg) < 0.5
     assert abs(sighting.x - plate_xy[0]) < 0.001
     assert abs(sighting.y - plate_xy[1]) < 0.001
@@ -116,13 +125,7 @@ def test_the_turn_is_read_with_a_corner_of_the_plate_hidden(yaw_deg: float):
     """Default lab, station_b/2: an arm link crossed one end of the held plate diagonally, the ends
     were not two parallel lines, and the plate went down 1.2 deg turned, unmeasured. Each edge's
     straightest stretch still gives the turn."""
-    depth, T_world_optical = _render((0.002, 0.001), (0.002, 0.001), yaw_deg=yaw_deg, cut_corner=True)
-    points = site_points(depth, CameraIntrinsics(), tf.invert(T_WORLD_SITE) @ T_world_optical)
-    tool = np.array([0.002, 0.001, APPROACH + GRASP_HEIGHT])
-    sighting = locate_held_plate(
-        points, tool, GRASP_HEIGHT, PLATE.length, PLATE.width, PLATE.height, PAD_WIDTH
-    )
-    assert sighting is not None
+    sighting = _sighting_held_at((0.002, 0.001), yaw_deg, cut_corner=True)
     assert abs(np.degrees(sighting.yaw) - yaw_deg) < 0.5
 
 
