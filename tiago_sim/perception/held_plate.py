@@ -52,6 +52,8 @@ TOP_SEARCH_M = 0.010
 # Pixels of the short side's edges are read this far beyond the pads' half-width from the tool (the
 # pads cover the middle of the long sides).
 BEYOND_PADS_M = 0.005
+# Pixels this far inside the long sides are clear of the pads and the sides' edges (the ends' pixels).
+CLEAR_OF_SIDES_M = 0.008
 # A side measured this much shorter or longer than the plate's is not both of its edges.
 EXTENT_TOLERANCE_M = 0.005
 EDGE_PERCENTILE = 1.0  # per cent: extents from robust percentiles, symmetric so the centre is unbiased
@@ -279,7 +281,7 @@ def locate_held_plate(
     near = (np.abs(points[:, 0] - tool_x) < length / 2 + 0.02) & (
         np.abs(points[:, 1] - tool_y) < width / 2 + 0.02
     )
-    inner = near & (np.abs(points[:, 1] - tool_y) < width / 2 - 0.008)
+    inner = near & (np.abs(points[:, 1] - tool_y) < width / 2 - CLEAR_OF_SIDES_M)
     searched = inner & (np.abs(points[:, 2] - nominal_top) < TOP_SEARCH_M)
     if searched.sum() < MIN_POINTS:
         log.debug("held plate: %d pixels near its top's height, too few", int(searched.sum()))
@@ -305,7 +307,7 @@ def locate_held_plate(
     c, s = math.cos(yaw), math.sin(yaw)
     unturn = np.array([[c, s], [-s, c]])  # rotation by -yaw (applied to row vectors as @ unturn.T)
     turned = (top_xy - pivot) @ unturn.T + pivot
-    inner_turned = np.abs(turned[:, 1] - tool_y) < width / 2 - 0.008
+    inner_turned = np.abs(turned[:, 1] - tool_y) < width / 2 - CLEAR_OF_SIDES_M
     final = _extents(turned, inner_turned, tool_x, pad_width)
     if final is None:
         return None

@@ -93,14 +93,18 @@ class Gripper:
         joints = self.body.joint_positions()
         return 2 * rm.FINGER_MOUNT_OFFSET + sum(joints[n] for n in self.fingers)
 
+    def _pads_on(self, plate: int) -> list[bool]:
+        """Whether each pad touches the plate body ``plate``."""
+        client = self.body.client
+        return [
+            bool(p.getContactPoints(self.body.id, plate, link, -1, physicsClientId=client))
+            for link in self.finger_links
+        ]
+
     def touching(self) -> str:
         """Labware id that both pads touch, or ""."""
-        client = self.body.client
         for labware_id, plate in self.plate_bodies.items():
-            if all(
-                p.getContactPoints(self.body.id, plate, link, -1, physicsClientId=client)
-                for link in self.finger_links
-            ):
+            if all(self._pads_on(plate)):
                 return labware_id
         return ""
 
@@ -116,12 +120,7 @@ class Gripper:
 
     def pads_clear_of(self, labware_id: str) -> bool:
         """Neither pad touches the plate (the opening fingers have left it)."""
-        plate = self.plate_bodies[labware_id]
-        client = self.body.client
-        return not any(
-            p.getContactPoints(self.body.id, plate, link, -1, physicsClientId=client)
-            for link in self.finger_links
-        )
+        return not any(self._pads_on(self.plate_bodies[labware_id]))
 
     def start_release(self) -> None:
         """The fingers are about to open: the grip check ends (their force no longer holds the plate by
@@ -206,7 +205,7 @@ class GripperMotion(Motion):
         if remaining < 5e-4 or self.stall_s > 0.0 or timed_out:
             if not self.close:
                 gripper.detach()  # open: nothing is held, whatever the contacts say
-            if self.close:
+            else:
                 labware_id = gripper.touching()
                 self.holding = bool(labware_id) and self.opening_m > 2 * rm.FINGER_MOUNT_OFFSET + 0.002
                 if self.holding:
