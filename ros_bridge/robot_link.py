@@ -21,18 +21,19 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from labware_interfaces.action import Dock, GetLabware, NavigateToPoi, PutLabware, Undock
-from labware_interfaces.msg import RobotState, StationStates
+from labware_interfaces.msg import LabwareInventory, RobotState, StationStates
 from labware_interfaces.srv import CheckPlacement, DescribeWorkcell
 
-from labware_model.holders import HotelSlot, Nest, parse_location
+from labware_model.holders import UNKNOWN, HotelSlot, Nest, parse_location
+from labware_model.inventory import LabwareRecord
 from labware_model.readings import HotelSlotReading, NestReading, PlacementCheck
 from labware_model.workcell import StationDescription, WorkcellDescription
 from ros_bridge.actions import ActionCaller, ActionGoal, GoalProgress
 from ros_bridge.errors import BridgeError
 from ros_bridge.runtime import RosRuntime
 from ros_bridge.services import ServiceCaller
-from ros_bridge.topics import TopicMirror
-from ros_bridge.workcell import LabwareHandover, RobotStatus
+from ros_bridge.topics import INVENTORY_QOS, TopicMirror
+from ros_bridge.workcell import InventorySnapshot, LabwareHandover, RobotStatus
 
 logger = logging.getLogger(__name__)
 
@@ -64,6 +65,22 @@ def nest_readings_from_message(message: StationStates) -> tuple[NestReading, ...
     )
 
 
+def inventory_from_message(message: LabwareInventory) -> InventorySnapshot:
+    """The records of a /labware_inventory message; a record with an unreadable location is
+    taken as unknown (and logged): the inventory never guesses."""
+    records = []
+    for record in message.records:
+        try:
+            location = parse_location(record.location)
+        except ValueError:
+            logger.error(
+                "/labware_inventory: %s has an unreadable location %r", record.labware_id, record.location
+            )
+            location = UNKNOWN
+        records.append(LabwareRecord(record.labware_id, record.labware_type, location, record.label))
+    return InventorySnapshot(int(message.revision), tuple(records))
+
+
 @dataclass(frozen=True)
 class _Endpoints:
     """The link's clients and mirrors on one runtime; replaced as a whole by `RobotLink.attach`."""
@@ -78,6 +95,7 @@ class _Endpoints:
     check_placement: ServiceCaller
     robot_state: TopicMirror
     station_states: TopicMirror
+    inventory: TopicMirror
 
     @classmethod
     def create(
@@ -85,6 +103,7 @@ class _Endpoints:
         runtime: RosRuntime,
         on_robot_state: Callable[[RobotState], None],
         on_station_states: Callable[[StationStates], None],
+        on_inventory: Callable[[LabwareInventory], None],
     ) -> _Endpoints:
         return cls(
             runtime,
@@ -97,6 +116,9 @@ class _Endpoints:
             ServiceCaller(runtime, CheckPlacement, "/check_placement"),
             TopicMirror(runtime, RobotState, "/robot_state", listeners=[on_robot_state]),
             TopicMirror(runtime, StationStates, "/station_states", listeners=[on_station_states]),
+            TopicMirror(
+                runtime, LabwareInventory, "/labware_inventory", qos=INVENTORY_QOS, listeners=[on_inventory]
+            ),
         )
 
 
@@ -109,7 +131,8 @@ class RobotLink:
     def __init__(self, runtime: RosRuntime) -> None:
         self._status_listeners: list[Callable[[RobotStatus], None]] = []
         self._nest_listeners: list[Callable[[tuple[NestReading, ...]], None]] = []
-        self._ros = _Endpoints.create(runtime, self._tell_status_listeners, self._tell_nest_listeners)
+        self._inventory_listeners: list[Callable[[InventorySnapshot], None]] = []
+        self._ros = self._endpoints(runtime)
 
     @property
     def runtime(self) -> RosRuntime:
@@ -121,16 +144,22 @@ class RobotLink:
         stay registered, and the last robot state and nest readings are carried over until the new
         robot side publishes. The old runtime's entities are its own to destroy (`stop()`)."""
         previous = self._ros
-        endpoints = _Endpoints.create(runtime, self._tell_status_listeners, self._tell_nest_listeners)
+        endpoints = self._endpoints(runtime)
         for old, new in (
             (previous.robot_state, endpoints.robot_state),
             (previous.station_states, endpoints.station_states),
+            (previous.inventory, endpoints.inventory),
         ):
             last = old.latest
             if last is not None:  # on the ROS thread: no real message can come in between
                 runtime.call(lambda mirror=new, message=last: _inject_unless_received(mirror, message))
         self._ros = endpoints
         logger.info("robot link attached to a new ROS runtime")
+
+    def _endpoints(self, runtime: RosRuntime) -> _Endpoints:
+        return _Endpoints.create(
+            runtime, self._tell_status_listeners, self._tell_nest_listeners, self._tell_inventory_listeners
+        )
 
     def wait_until_ready(self, timeout_s: float = 30.0) -> None:
         """Wait for every action server, service and state topic; raise ServerUnavailable naming one."""
@@ -141,6 +170,7 @@ class RobotLink:
             service.wait_for_service(timeout_s)
         ros.robot_state.wait_for_message(timeout_s)
         ros.station_states.wait_for_message(timeout_s)
+        ros.inventory.wait_for_message(timeout_s)
 
     # --- actions: each returns a goal handle at once (wait on it, cancel it) ---
 
@@ -262,6 +292,22 @@ class RobotLink:
         except BridgeError:  # no ROS thread to deliver it: nobody else calls the listeners now
             ros.robot_state.inject(message)
 
+    def inventory(self, timeout_s: float = 5.0) -> InventorySnapshot:
+        """The robot side's latest inventory (waits for the first message up to `timeout_s`)."""
+        return inventory_from_message(self._ros.inventory.wait_for_message(timeout_s))
+
+    def wait_for_inventory(
+        self, predicate: Callable[[InventorySnapshot], bool], timeout_s: float = 5.0
+    ) -> InventorySnapshot:
+        message = self._ros.inventory.wait_for_message(
+            timeout_s, lambda message: predicate(inventory_from_message(message))
+        )
+        return inventory_from_message(message)
+
+    def on_inventory(self, listener: Callable[[InventorySnapshot], None]) -> None:
+        """Call `listener(snapshot)` on every change of /labware_inventory (on the ROS thread)."""
+        self._inventory_listeners.append(listener)
+
     def on_nest_readings(self, listener: Callable[[tuple[NestReading, ...]], None]) -> None:
         """Call `listener(readings)` on every change of /station_states (on the ROS thread)."""
         self._nest_listeners.append(listener)
@@ -270,6 +316,11 @@ class RobotLink:
         status = robot_status_from_message(message)
         for listener in list(self._status_listeners):
             _tell(listener, status, "/robot_state")
+
+    def _tell_inventory_listeners(self, message: LabwareInventory) -> None:
+        snapshot = inventory_from_message(message)
+        for listener in list(self._inventory_listeners):
+            _tell(listener, snapshot, "/labware_inventory")
 
     def _tell_nest_listeners(self, message: StationStates) -> None:
         readings = nest_readings_from_message(message)

@@ -33,6 +33,14 @@ STATE_QOS = QoSProfile(
     durability=QoSDurabilityPolicy.VOLATILE,
 )
 
+INVENTORY_QOS = QoSProfile(
+    history=QoSHistoryPolicy.KEEP_LAST,
+    depth=1,
+    reliability=QoSReliabilityPolicy.RELIABLE,
+    durability=QoSDurabilityPolicy.TRANSIENT_LOCAL,
+)
+"""/labware_inventory: published on change (and at 1 Hz), so a late reader gets the last one at once."""
+
 
 def message_without_stamp(message: Any) -> tuple:
     """A comparable snapshot of a message, ignoring a top-level `stamp` field."""

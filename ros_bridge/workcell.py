@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 from labware_model.holders import HotelSlot, Nest
+from labware_model.inventory import LabwareRecord
 from labware_model.readings import HotelSlotReading
 
 
@@ -55,6 +56,15 @@ class RobotStatus:
     def onboard_labware_ids(self) -> tuple[str, ...]:
         held = (self.held_labware_id,) if self.held_labware_id else ()
         return tuple(slot.labware_id for slot in self.hotel if slot.labware_id) + held
+
+
+@dataclass(frozen=True)
+class InventorySnapshot:
+    """One /labware_inventory message: the robot side's named plates and where its sensors put
+    them (labware_model.inventory), with the revision that grows with every change."""
+
+    revision: int
+    records: tuple[LabwareRecord, ...]
 
 
 @dataclass(frozen=True)

@@ -9,12 +9,14 @@ Tasks follow the beamline paper's four types, mapped onto our task-level actions
 
 Which station/nest is "storage" and which is "beam" is given to the constructor; the robot side
 decides whether a goal is possible and says why not (the status then fails with the action's
-error code and message). `read()` reports the robot state from /robot_state: state word, what
-the base is near, what the robot carries, where the base stands. `stop()` cancels every goal
-this device has running.
+error code and message). `read()` reports the robot state from /robot_state (state word, what
+the base is near, where it stands) and, from the robot side's one inventory (/labware_inventory,
+the same the SiLA servers read), what the robot carries and where every named plate is.
+`stop()` cancels every goal this device has running.
 
 Threads: `set`, `trigger`, `read` and `stop` are called from the RunEngine's threads; the
-readings are updated on the ROS thread from /robot_state (`RobotLink.on_robot_status`).
+readings are updated on the ROS thread from /robot_state and /labware_inventory
+(`RobotLink.on_robot_status`, `RobotLink.on_inventory`).
 """
 
 from __future__ import annotations
@@ -29,11 +31,11 @@ from typing import Any
 from ophyd import Component, Device, Signal, SignalRO
 from ophyd.status import DeviceStatus
 
-from labware_model.holders import HotelSlot, Nest
+from labware_model.holders import GRIPPER, HotelSlot, Nest, aboard, location_text
 from ros_bridge.bluesky.status import ActionStatus
 from ros_bridge.errors import BridgeError
 from ros_bridge.robot_link import LabwareHandover, RobotLink
-from ros_bridge.workcell import RobotStatus
+from ros_bridge.workcell import InventorySnapshot, RobotStatus
 
 logger = logging.getLogger(__name__)
 
@@ -65,6 +67,8 @@ class LabwareTransferRobot(Device):
     state = Component(RobotReading, value="", kind="hinted")
     carried_labware = Component(RobotReading, value="", kind="hinted")
     held_labware = Component(RobotReading, value="", kind="normal")
+    labware_locations = Component(RobotReading, value="", kind="normal")
+    """Every plate the robot side's inventory names: "name=location" joined by commas."""
     current_poi = Component(RobotReading, value="", kind="normal")
     detail = Component(RobotReading, value="", kind="normal")
     base_x = Component(RobotReading, value=0.0, kind="normal")
@@ -105,6 +109,11 @@ class LabwareTransferRobot(Device):
         latest = link.latest_robot_status()
         if latest is not None:
             self._report_robot_status(latest)
+        link.on_inventory(self._report_inventory)
+        try:
+            self._report_inventory(link.inventory(timeout_s=0.0))
+        except BridgeError:
+            pass  # none yet: the first one is reported when it comes
 
     @property
     def current_status(self) -> ActionStatus | None:
@@ -162,13 +171,24 @@ class LabwareTransferRobot(Device):
     def _report_robot_status(self, robot: RobotStatus, timestamp: float | None = None) -> None:
         received_at = time.time() if timestamp is None else timestamp
         self.state.report(robot.state, received_at)
-        self.carried_labware.report(_joined(robot.onboard_labware_ids), received_at)
-        self.held_labware.report(robot.held_labware_id, received_at)
         self.current_poi.report(robot.current_poi, received_at)
         self.detail.report(robot.detail, received_at)
         self.base_x.report(robot.x_m, received_at)
         self.base_y.report(robot.y_m, received_at)
         self.base_theta.report(robot.theta_rad, received_at)
+
+    def _report_inventory(self, inventory: InventorySnapshot) -> None:
+        received_at = time.time()
+        records = inventory.records
+        self.carried_labware.report(
+            _joined(tuple(r.labware_id for r in records if aboard(r.location))), received_at
+        )
+        self.held_labware.report(
+            next((r.labware_id for r in records if r.location == GRIPPER), ""), received_at
+        )
+        self.labware_locations.report(
+            _joined(tuple(f"{r.labware_id}={location_text(r.location)}" for r in records)), received_at
+        )
 
     def _parse_task(self, value: str | TransferTask | Mapping[str, Any]) -> tuple[TransferTask, str]:
         labware_id = str(self.labware_id.get())

@@ -33,7 +33,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from labware_model.holders import UNKNOWN, location_text
+from labware_model.holders import location_text
 from ros_bridge.errors import BridgeError
 from ros_bridge.robot_link import RobotLink
 from sila_labware.deployment.processes import ProcessGroup
@@ -41,6 +41,9 @@ from sila_labware.device.robot_controller import RobotController
 
 logger = logging.getLogger(__name__)
 
+
+INVENTORY_AFTER_RESTART_S = 5.0
+"""How long the new robot side has to publish an inventory that follows its fresh sensors."""
 
 ROS_THREAD = "ros_thread"
 """The name a restart record gives the bridge's ROS thread (the children go by theirs)."""
@@ -154,8 +157,8 @@ class RobotSideSupervisor:
         logger.error("%s", reason)
         self.link.mark_robot_side_lost(reason)
         self.robot.abort_active_goal(reason)
-        for labware in self.robot.inventory.records():
-            self.robot.inventory.record(labware.labware_id, labware.labware_type, UNKNOWN)
+        revision_at_loss = self.robot.inventory.revision
+        self.robot.inventory.mark_all_unknown()
         self.children.stop(timeout_s=2.0)
         # The surviving node published until it was stopped; let its last samples arrive, then
         # mark the side lost again so only the new robot side's state counts as "back".
@@ -171,8 +174,7 @@ class RobotSideSupervisor:
             self.failure = f"restarting the robot side failed: {error}"
             logger.error("%s", self.failure)
             return
-        time.sleep(0.5)  # let the new /station_states arrive too
-        self._resynchronise_inventory()
+        self._resynchronise_inventory(revision_at_loss)
         record.ready_after_s = time.monotonic() - record.started_at
         logger.warning("robot side back after %.1f s", record.ready_after_s)
 
@@ -194,12 +196,18 @@ class RobotSideSupervisor:
                     raise
         raise BridgeError("stopped while waiting for the robot side")
 
-    def _resynchronise_inventory(self) -> None:
-        """Every known plate goes where the new robot side's observations put it, or stays unknown."""
-        status = self.link.robot_status()
-        nests = self.link.nest_readings()
-        for labware in self.robot.inventory.records():
-            location = self.robot.inventory.settle(
-                labware.labware_id, labware.labware_type, None, status, nests
+    def _resynchronise_inventory(self, revision_at_loss: int) -> None:
+        """Wait for the new robot side's inventory: it kept its names in its file and put every
+        plate where its fresh sensors see it (labware_model.inventory), or marked it unknown."""
+        try:
+            snapshot = self.link.wait_for_inventory(
+                lambda snapshot: snapshot.revision > revision_at_loss, INVENTORY_AFTER_RESTART_S
             )
-            logger.info("after restart, %s observed at %s", labware.labware_id, location_text(location))
+        except BridgeError:
+            logger.warning("the new robot side published no newer inventory: plates stay unknown")
+            return
+        self.robot.inventory.replace(snapshot)
+        for labware in snapshot.records:
+            logger.info(
+                "after restart, %s observed at %s", labware.labware_id, location_text(labware.location)
+            )

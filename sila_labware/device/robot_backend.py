@@ -29,7 +29,7 @@ from labware_model.holders import Nest
 from labware_model.readings import NestReading
 from ros_bridge.goal_status import ActionGoal
 from ros_bridge.progress import GoalProgress
-from ros_bridge.workcell import LabwareHandover, RobotStatus
+from ros_bridge.workcell import InventorySnapshot, LabwareHandover, RobotStatus
 
 FeedbackListener = Callable[[GoalProgress], None]
 
@@ -51,7 +51,7 @@ class StationBackend(Protocol):
 
 @runtime_checkable
 class RobotBackend(StationBackend, Protocol):
-    """The ten methods `RobotController` uses: state, state waits, and the robot's five goals."""
+    """The methods `RobotController` uses: state, state waits, the inventory, and the robot's five goals."""
 
     # --- robot state ---
 
@@ -69,6 +69,24 @@ class RobotBackend(StationBackend, Protocol):
 
     def on_robot_status(self, listener: Callable[[RobotStatus], None]) -> None:
         """Call `listener(status)` on every change of the robot state, on the answering thread."""
+        ...
+
+    # --- the robot side's inventory (labware_model.inventory) ---
+
+    def inventory(self, timeout_s: float = 5.0) -> InventorySnapshot:
+        """The robot side's latest inventory: every named plate and where its sensors put it.
+        Waits up to `timeout_s` s for a first one; raises BridgeTimeout if none came."""
+        ...
+
+    def wait_for_inventory(
+        self, predicate: Callable[[InventorySnapshot], bool], timeout_s: float = 5.0
+    ) -> InventorySnapshot:
+        """Return the first inventory (the latest one included) for which `predicate` is true;
+        raise BridgeTimeout after `timeout_s` s."""
+        ...
+
+    def on_inventory(self, listener: Callable[[InventorySnapshot], None]) -> None:
+        """Call `listener(snapshot)` on every change of the inventory, on the answering thread."""
         ...
 
     # --- goals: each returns its ActionGoal at once ---

@@ -8,9 +8,13 @@ implementations translate its exceptions into SiLA errors:
 - `CommandSequenceError` -> InvalidCommandSequence (RobotBusy for motion commands)
 - `ParameterError` -> a validation error naming the parameter
 - `TransferFailed` -> LabwareNotPicked / LabwareNotPlaced, with the robot side's message; also
-  when the robot side reported success but the sensors do not show the plate where the command
-  put it (PLATE_SLIPPED after GetLabware, PLACE_FAILED after PutLabware)
+  when the robot side reported success but the presence sensor of the place the command put the
+  plate sees none (PLATE_SLIPPED after GetLabware, PLACE_FAILED after PutLabware)
 - `MotionFailed` -> the MobileRobotController error for its ROS error code
+
+The inventory is the robot side's (labware_model.inventory), mirrored here (`inventory`): the
+scheduler's LabwareUniqueID is the plate's name, which the robot side takes at the source of a
+transfer; where a plate is follows the robot's presence sensors, never a label read off it.
 
 Progress: each command reports through one `CommandProgress` (ros_bridge.progress), which maps
 each of its goals into a share of the command (undock 0..0.2, then drive 0.2..1) and never lets
@@ -30,7 +34,7 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable
 
-from labware_model.holders import UNKNOWN, HotelSlot, Location, Nest, location_text
+from labware_model.holders import UNKNOWN, HotelSlot, Location, Nest, aboard, location_text
 from labware_model.workcell import WorkcellDescription
 from ros_bridge.errors import BridgeTimeout
 from ros_bridge.goal_status import ActionGoal, ActionOutcome
@@ -40,7 +44,7 @@ from ros_bridge.workcell import LabwareHandover, RobotStatus
 from sila_labware.device.cancellation import CancelToken
 from sila_labware.device.errors import CommandSequenceError, MotionFailed, TransferFailed
 from sila_labware.device.goal_runner import ControllerWaits, GoalRunner
-from sila_labware.device.inventory import Inventory, unread_in_slot
+from sila_labware.device.inventory import Inventory
 from sila_labware.device.robot_backend import RobotBackend
 from sila_labware.device.sequences import ManipulatorSequence, PreparedTransfer
 from sila_labware.device.validation import DeviceParameters
@@ -75,9 +79,12 @@ class RobotController:
             INTERMEDIATE_ACTIONS,
         )
         self.pace = RobotPace()  # remaining times are reported in wall seconds at the robot's pace
-        link.on_robot_status(self.inventory.observe_robot)
+        link.on_inventory(self.inventory.replace)
         link.on_robot_status(self.pace.observe)
-        self.inventory.observe_robot(link.robot_status())
+        try:
+            self.inventory.replace(link.inventory(timeout_s=0.0))
+        except BridgeTimeout:
+            pass  # none published yet: the listener takes the first one
 
     # --- what the robot offers ---
 
@@ -106,10 +113,11 @@ class RobotController:
         )
         occupant = self._hotel_occupant(self.link.robot_status(), internal_position)
         if occupant is not None:
-            what = f"labware {occupant!r}" if occupant else "a plate whose label its reader could not read"
+            what = f"labware {occupant!r}" if occupant else "a plate nobody has named"
             raise CommandSequenceError(
                 f"PrepareForInput refused: internal position {internal_position} already holds {what}"
             )
+        self._refuse_a_name_in_use(labware_id, handover)
         transfer = PreparedTransfer(handover, internal_position, labware_type, labware_id)
         self.sequence.begin_prepare_for_input(transfer)
         self._drive_for_transfer(handover, CommandProgress(report, self.pace.to_wall_s))
@@ -120,20 +128,12 @@ class RobotController:
         """Robot will hand a plate to `position`: the hotel slot must hold one; drive there."""
         handover = self.parameters.prepare(position, sub_position, internal_position)
         occupant = self._hotel_occupant(self.link.robot_status(), internal_position)
-        if occupant == "":  # a plate whose label was not read: the one the inventory put there
-            recorded = self.inventory.in_hotel_slot(internal_position)
-            if recorded is None:
-                raise CommandSequenceError(
-                    f"PrepareForOutput refused: internal position {internal_position} holds a plate "
-                    "whose label its reader could not read, and the inventory has no record of one there"
-                )
-            occupant = recorded.labware_id
         if occupant is None:
             raise CommandSequenceError(
                 f"PrepareForOutput refused: internal position {internal_position} holds no labware"
             )
         self._refuse_occupied_destination(handover)
-        known = self.inventory.locate(occupant)
+        known = self.inventory.locate(occupant) if occupant else None
         transfer = PreparedTransfer(
             handover, internal_position, known.labware_type if known else "", occupant
         )
@@ -185,11 +185,11 @@ class RobotController:
             send = self.link.get_labware if getting else self.link.put_labware
             progress = CommandProgress(report, self.pace.to_wall_s)
             outcome = self.goals.run(lambda: send(request, progress.step(0.0, 1.0)), command)
-            labware_id = transfer.labware_id or str(getattr(outcome.result, "labware_id", ""))
-            location = self._settle(labware_id, transfer, outcome, expect_aboard=getting)
+            labware_id = str(getattr(outcome.result, "labware_id", "")) or transfer.labware_id
+            self._settle(labware_id, transfer, outcome)
             if not outcome.success:
                 raise TransferFailed(outcome.error_code, _describe_failure(command, outcome))
-            self._refuse_unseen_effect(command, labware_id, transfer, location)
+            self._refuse_unseen_effect(command, labware_id, transfer)
             return labware_id
         finally:
             self.sequence.finish_transfer()
@@ -279,51 +279,60 @@ class RobotController:
         finally:
             self.sequence.finish_prepare(success)
 
-    def _settle(
-        self, labware_id: str, transfer: PreparedTransfer, outcome: ActionOutcome, expect_aboard: bool
-    ) -> Location | None:
-        """Record where the plate really is, after the robot side reported the outcome; returns
-        that location (None without a labware id: then the inventory is not updated)."""
+    def _settle(self, labware_id: str, transfer: PreparedTransfer, outcome: ActionOutcome) -> None:
+        """Bring the mirror up to the robot side's inventory as the goal left it (the result carries
+        that revision; an older robot side that sends none is waited for one report)."""
         if not labware_id:
-            logger.warning("transfer at %s without a labware id: inventory not updated", transfer.handover)
-            return None
-
-        slot = HotelSlot(transfer.internal_position)
-
-        def shows_outcome(status: RobotStatus) -> bool:
-            aboard = labware_id in status.onboard_labware_ids or unread_in_slot(status, slot)
-            return aboard == expect_aboard if outcome.success else True
-
+            logger.warning("transfer at %s without a labware id: nobody named the plate", transfer.handover)
+        revision = int(getattr(outcome.result, "inventory_revision", 0) or 0)
         try:
-            status = self.link.wait_for_robot_status(shows_outcome, self.waits.settle_s)
+            snapshot = self.link.wait_for_inventory(
+                lambda snapshot: snapshot.revision >= revision, self.waits.settle_s
+            )
         except BridgeTimeout:
-            status = self.link.robot_status()
-        if outcome.success and not expect_aboard:
-            # /station_states comes at 2 Hz, /robot_state on change: without this wait a plate that
-            # was placed could be read as in neither place, and recorded as lost (seen in the soak).
-            try:
-                self.link.wait_for_nest(transfer.handover, True, self.waits.settle_s)
-            except BridgeTimeout:
-                pass  # the sensors do not show the place: _refuse_unseen_effect says so
-        return self.inventory.settle(
-            labware_id, transfer.labware_type, transfer.handover, status, self.link.nest_readings(), slot
-        )
+            logger.warning("no /labware_inventory of revision %d within %g s", revision, self.waits.settle_s)
+            return
+        self.inventory.replace(snapshot)
 
-    def _refuse_unseen_effect(
-        self, command: str, labware_id: str, transfer: PreparedTransfer, location: Location | None
-    ) -> None:
-        """A transfer the robot side reported done must show in the sensors as well: the plate in
-        the prepared hotel slot after GetLabware, in the nest after PutLabware; else TransferFailed."""
+    def _refuse_unseen_effect(self, command: str, labware_id: str, transfer: PreparedTransfer) -> None:
+        """A transfer the robot side reported done must show in the presence sensor of the place it
+        put the plate: its hotel slot after GetLabware, its nest after PutLabware; else TransferFailed.
+        Presence only: a label that reads other than the plate's name is a note, not a slip."""
         getting = command == "GetLabware"
         expected: Location = HotelSlot(transfer.internal_position) if getting else transfer.handover
-        if location is None or location == expected:  # None: no id, nothing to look for
+        try:
+            if getting:
+                self.link.wait_for_robot_status(
+                    lambda status: self._hotel_occupant(status, transfer.internal_position) is not None,
+                    self.waits.settle_s,
+                )
+            else:
+                self.link.wait_for_nest(transfer.handover, True, self.waits.settle_s)
             return
-        where = "nowhere a sensor sees" if location == UNKNOWN else location_text(location)
+        except BridgeTimeout:
+            pass
+        record = self.inventory.locate(labware_id) if labware_id else None
+        where = (
+            ""
+            if record is None or record.location == UNKNOWN
+            else f"; the inventory has it at {location_text(record.location)}"
+        )
         code = "PLATE_SLIPPED" if getting else "PLACE_FAILED"
         raise TransferFailed(
             code,
-            f"{command} failed ({code}): the robot side reported success, but the sensors put "
-            f"{labware_id} at {where}, not {location_text(expected)}",
+            f"{command} failed ({code}): the robot side reported success, but the sensor of "
+            f"{expected} sees no plate{where}",
+        )
+
+    def _refuse_a_name_in_use(self, labware_id: str, handover: Nest) -> None:
+        """PrepareForInput names the plate at `handover`: no other plate may carry that name."""
+        record = self.inventory.locate(labware_id) if labware_id else None
+        if record is None or record.location in (handover, UNKNOWN):
+            return
+        where = "already aboard" if aboard(record.location) else f"at {location_text(record.location)}"
+        raise CommandSequenceError(
+            f"PrepareForInput refused: labware {labware_id!r} is {where}, not at {handover}; "
+            "a labware id names one plate"
         )
 
     def _refuse_occupied_destination(self, handover: Nest) -> None:
@@ -336,12 +345,13 @@ class RobotController:
                     "the robot did not move"
                 )
 
-    @staticmethod
-    def _hotel_occupant(status: RobotStatus, slot: int) -> str | None:
-        """The id of the plate in the slot; "" for a plate its reader could not read; None if empty."""
+    def _hotel_occupant(self, status: RobotStatus, slot: int) -> str | None:
+        """The name of the plate in the hotel slot ("" for a plate nobody named); None when its
+        presence sensor sees none."""
         for reading in status.hotel:
             if reading.slot.index == slot and reading.occupied:
-                return reading.labware_id
+                record = self.inventory.in_hotel_slot(slot)
+                return record.labware_id if record is not None else ""
         return None
 
 

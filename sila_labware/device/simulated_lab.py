@@ -36,6 +36,7 @@ FAULTS_DURING_A_COMMAND = frozenset({"DropPlate", "KnockPlate", "OccludeMarker",
 TARGET_REFUSALS = ("unknown plate", "unknown station", "fault.block_path")
 """How the sim node's refusal of a fault's target begins (tiago_sim.sim_node.node)."""
 REPORT_AFTER_RESET_S = 10.0  # the robot side reports its state at 20 Hz; generous under load
+INVENTORY_AFTER_RESET_S = 2.0  # the inventory follows the next pair of reports (2 Hz and faster)
 
 
 class SimulationBackend(Protocol):
@@ -151,10 +152,16 @@ class SimulatedLab:
             self._faults.append(f"{fault} {target}")
 
     def _take_inventory_anew(self) -> None:
-        """Every plate the inventory knows goes where the robot side's next reports put it."""
-        status, nests = self.simulation.reports_after_reset(REPORT_AFTER_RESET_S)
-        for record in self.robot.inventory.records():
-            self.robot.inventory.settle(record.labware_id, record.labware_type, None, status, nests)
+        """The robot side's inventory follows its sensors once the reset lab reports (plates keep
+        their names where their labels are read again): wait for that, briefly."""
+        revision = self.robot.inventory.revision
+        self.simulation.reports_after_reset(REPORT_AFTER_RESET_S)
+        try:
+            self.robot.inventory.replace(
+                self.robot.link.wait_for_inventory(lambda s: s.revision > revision, INVENTORY_AFTER_RESET_S)
+            )
+        except BridgeError:
+            pass  # nothing moved under a name: the inventory had nothing to change
 
     @staticmethod
     def _call(request) -> str:  # noqa: ANN001 - a zero-argument callable

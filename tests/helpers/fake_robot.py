@@ -7,6 +7,10 @@ plate moved between nest and hotel), `fail(code)`, `never_ends()` (no answer, ca
 real `ActionGoal` finished by the fake, as the ROS bridge's ROS thread finishes it in a
 deployment; every goal sent is recorded in `sent`.
 
+Like the robot side, it keeps the one inventory (a `labware_model.inventory.LabwareBook`): a
+transfer names its plate at the source and settles it on presence; what the test sets between
+transfers is followed as the robot side follows its sensors. Readers get it as `inventory()`.
+
 Threads: a goal that ends does so inside the call that sends it (feedback first, then the end),
 on the calling thread; one scripted to wait is finished by a cancel request, on the canceller's
 thread. State waits use a condition, so a test may change the state from another thread.
@@ -23,12 +27,13 @@ from dataclasses import dataclass, field, replace
 from types import SimpleNamespace
 from typing import Any
 
-from labware_model.holders import HotelSlot, Nest
+from labware_model.holders import GRIPPER, HotelSlot, Location, Nest
+from labware_model.inventory import LabwareBook, NameTaken, sensed_plates
 from labware_model.readings import HotelSlotReading, NestReading
 from ros_bridge.errors import BridgeError, BridgeTimeout
 from ros_bridge.goal_status import ActionGoal, ActionOutcome
 from ros_bridge.progress import GoalProgress
-from ros_bridge.workcell import LabwareHandover, RobotStatus
+from ros_bridge.workcell import InventorySnapshot, LabwareHandover, RobotStatus
 
 FeedbackListener = Callable[[GoalProgress], None]
 
@@ -117,6 +122,10 @@ class FakeRobot:
         self._listeners: list[Callable[[RobotStatus], None]] = []
         self._scripts: dict[str, deque[ScriptedGoal]] = defaultdict(deque)
         self.sent: list[SentGoal] = []
+        self.book = LabwareBook()
+        self._inventory = InventorySnapshot(1, ())
+        self._inventory_listeners: list[Callable[[InventorySnapshot], None]] = []
+        self._follow_sensors()
 
     # --- the test's controls ---
 
@@ -125,6 +134,16 @@ class FakeRobot:
         self._scripts[action].extend(goals)
 
     def set_robot_status(self, robot: RobotStatus) -> None:
+        """What the robot reports from now on; the inventory follows it (between transfers)."""
+        self._report_robot(robot)
+        self._follow_sensors()
+
+    def set_nests(self, nests: tuple[NestReading, ...]) -> None:
+        """What the nest sensors report from now on; the inventory follows them."""
+        self._report_nests(nests)
+        self._follow_sensors()
+
+    def _report_robot(self, robot: RobotStatus) -> None:
         with self._changed:
             changed, self._robot = robot != self._robot, robot
             listeners = list(self._listeners) if changed else []
@@ -132,10 +151,27 @@ class FakeRobot:
         for listener in listeners:
             listener(robot)
 
-    def set_nests(self, nests: tuple[NestReading, ...]) -> None:
+    def _report_nests(self, nests: tuple[NestReading, ...]) -> None:
         with self._changed:
             self._nests = tuple(nests)
             self._changed.notify_all()
+
+    def _sensed(self) -> tuple[Any, set[Location]]:
+        robot, nests = self.robot_status(), self.nest_readings()
+        plates = sensed_plates(robot.hotel, robot.holding, robot.held_labware_id, nests)
+        return plates, {r.slot for r in robot.hotel} | {r.nest for r in nests} | {GRIPPER}
+
+    def _follow_sensors(self) -> None:
+        if self.book.reconcile(*self._sensed()):
+            self._publish_inventory()
+
+    def _publish_inventory(self) -> None:
+        with self._changed:
+            self._inventory = InventorySnapshot(self._inventory.revision + 1, self.book.records())
+            snapshot, listeners = self._inventory, list(self._inventory_listeners)
+            self._changed.notify_all()
+        for listener in listeners:
+            listener(snapshot)
 
     def actions_sent(self) -> list[str]:
         return [sent.action for sent in self.sent]
@@ -161,6 +197,22 @@ class FakeRobot:
     def nest_readings(self, timeout_s: float = 5.0) -> tuple[NestReading, ...]:
         with self._changed:
             return self._nests
+
+    def inventory(self, timeout_s: float = 5.0) -> InventorySnapshot:
+        with self._changed:
+            return self._inventory
+
+    def wait_for_inventory(
+        self, predicate: Callable[[InventorySnapshot], bool], timeout_s: float = 5.0
+    ) -> InventorySnapshot:
+        with self._changed:
+            if not self._changed.wait_for(lambda: predicate(self._inventory), timeout_s):
+                raise BridgeTimeout(f"no matching message on /labware_inventory within {timeout_s:.1f} s")
+            return self._inventory
+
+    def on_inventory(self, listener: Callable[[InventorySnapshot], None]) -> None:
+        with self._changed:
+            self._inventory_listeners.append(listener)
 
     def wait_for_nest(self, nest: Nest, occupied: bool, timeout_s: float = 5.0) -> None:
         def shows() -> bool:
@@ -210,19 +262,57 @@ class FakeRobot:
             goal.set_rejected()
             return goal
         goal.set_accepted()
+        try:
+            name = self._name_plate(action, argument)
+        except NameTaken as taken:
+            goal.set_finished(ActionOutcome(False, "LABWARE_ELSEWHERE", str(taken), "ABORTED", None))
+            return goal
         for fraction in script.feedback:
             goal.update_progress(fraction, action, 1.0 - fraction)
         if script.while_running is not None:
             script.while_running()
         if script.end is GoalEnd.SUCCEED:
             self._apply(script.robot_after or self._natural_effect(action, argument), script.nests_after)
-            goal.set_finished(ActionOutcome(True, "", f"{action} done", "SUCCEEDED", script.result))
+            result = self._settle(action, argument, name, script.result)
+            goal.set_finished(ActionOutcome(True, "", f"{action} done", "SUCCEEDED", result))
         elif script.end is GoalEnd.FAIL:
             self._apply(script.robot_after, script.nests_after)
-            goal.set_finished(
-                ActionOutcome(False, script.error_code, script.message, "ABORTED", script.result)
-            )
+            result = self._settle(action, argument, name, script.result)
+            goal.set_finished(ActionOutcome(False, script.error_code, script.message, "ABORTED", result))
         return goal
+
+    def _name_plate(self, action: str, argument: Any) -> str:
+        """A transfer names its plate at its source before anything moves (as the sequencer does)."""
+        if action not in ("get_labware", "put_labware"):
+            return ""
+        handover: LabwareHandover = argument
+        source = handover.nest if action == "get_labware" else handover.hotel_slot
+        label = self._label_at(source)
+        before = self.book.records()
+        record = self.book.name_plate(source, handover.labware_id, handover.labware_type, label)
+        if self.book.records() != before:
+            self._publish_inventory()
+        return record.labware_id if record is not None else ""
+
+    def _settle(self, action: str, argument: Any, name: str, scripted: Any) -> Any:
+        """After a transfer: its plate where presence says; the result names it and the revision."""
+        if action not in ("get_labware", "put_labware"):
+            return scripted
+        handover: LabwareHandover = argument
+        getting = action == "get_labware"
+        source, destination = (
+            (handover.nest, handover.hotel_slot) if getting else (handover.hotel_slot, handover.nest)
+        )
+        if name and self.book.settle(name, (destination, GRIPPER, source), self._sensed()[0]):
+            self._publish_inventory()
+        if scripted is not None:
+            return scripted
+        return SimpleNamespace(labware_id=name, inventory_revision=self.inventory().revision)
+
+    def _label_at(self, holder: Location) -> str:
+        if isinstance(holder, Nest):
+            return next((r.labware_id for r in self.nest_readings() if r.nest == holder), "")
+        return next((r.labware_id for r in self.robot_status().hotel if r.slot == holder), "")
 
     def _cancel(self, sent: SentGoal, script: ScriptedGoal, timeout_s: float) -> bool:
         sent.cancel_requests.append(timeout_s)
@@ -236,10 +326,11 @@ class FakeRobot:
         return True
 
     def _apply(self, robot: RobotStatus | None, nests: tuple[NestReading, ...] | None) -> None:
+        """A goal's effect on what the robot reports (the inventory is settled by the goal)."""
         if nests is not None:
-            self.set_nests(nests)
+            self._report_nests(nests)
         if robot is not None:
-            self.set_robot_status(robot)
+            self._report_robot(robot)
 
     def _natural_effect(self, action: str, argument: Any) -> RobotStatus:
         """What a successful goal leaves: the base at the POI, (un)docked, the plate moved."""
@@ -252,29 +343,24 @@ class FakeRobot:
             return replace(robot, state="idle")
         handover: LabwareHandover = argument
         getting = action == "get_labware"
-        plate = handover.labware_id or (self._plate_in_nest(handover) if getting else "")
-        slot_plate = plate if getting else ""
+        label = self._label_at(handover.nest if getting else handover.hotel_slot)  # moves with the plate
         hotel = tuple(
-            replace(slot, labware_id=slot_plate, labware_type=handover.labware_type if getting else "")
+            HotelSlotReading(slot.slot, label, handover.labware_type, occupied=True)
+            if slot.slot == handover.hotel_slot and getting
+            else HotelSlotReading(slot.slot)
             if slot.slot == handover.hotel_slot
             else slot
             for slot in robot.hotel
         )
-        self.set_nests(
+        self._report_nests(
             tuple(
-                NestReading(reading.nest, not getting, "" if getting else plate)
+                NestReading(reading.nest, not getting, "" if getting else label)
                 if reading.nest == handover.nest
                 else reading
                 for reading in self.nest_readings()
             )
         )
         return replace(robot, hotel=hotel)
-
-    def _plate_in_nest(self, handover: LabwareHandover) -> str:
-        for reading in self.nest_readings():
-            if reading.nest == handover.nest:
-                return reading.labware_id
-        return ""
 
 
 def result_with_labware_id(labware_id: str) -> SimpleNamespace:

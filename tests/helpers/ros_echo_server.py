@@ -3,7 +3,8 @@
 Serves /navigate_to_poi (NavigateToPoi): drives a pretend base for `--goal-seconds`, sending
 feedback at 20 Hz; POI "nowhere" aborts with UNKNOWN_POI; cancel is honoured. Serves
 /describe_workcell with two stations. Publishes RobotState on /robot_state at 10 Hz, whose
-`detail` counts the goals finished so far. Prints "READY" once everything is created.
+`detail` counts the goals finished so far, and an empty /labware_inventory (nothing aboard, no
+plate named). Prints "READY" once everything is created.
 
 A misbehaving robot side, for the bridge's own tests: `--accept-delay-s S` answers every goal
 request only after S seconds (a slow or overloaded action server), and `--goal-log FILE` appends
@@ -21,13 +22,14 @@ from pathlib import Path
 
 import rclpy
 from labware_interfaces.action import NavigateToPoi
-from labware_interfaces.msg import ErrorCodes, RobotState, StationInfo
+from labware_interfaces.msg import ErrorCodes, LabwareInventory, RobotState, StationInfo
 from labware_interfaces.srv import DescribeWorkcell
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
 from ros_bridge.latency_peer import serve_node
+from ros_bridge.topics import INVENTORY_QOS
 
 
 class EchoRobot(Node):
@@ -58,6 +60,9 @@ class EchoRobot(Node):
         )
         self._state_publisher = self.create_publisher(RobotState, "/robot_state", 1)
         self._timer = self.create_timer(0.1, self._publish_state, callback_group=group)
+        self.create_publisher(LabwareInventory, "/labware_inventory", INVENTORY_QOS).publish(
+            LabwareInventory(revision=1)
+        )
 
     def _accept(self, goal: NavigateToPoi.Goal) -> GoalResponse:
         time.sleep(self._accept_delay_s)

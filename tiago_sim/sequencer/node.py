@@ -52,17 +52,21 @@ from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.task import Future
 
+from labware_model.holders import GRIPPER
+from labware_model.inventory import NameTaken
 from labware_model.workcell import WorkcellDescription
 from tiago_sim.node_main import spin_node
+from tiago_sim.sequencer.inventory_keeper import InventoryKeeper
 from tiago_sim.sequencer.plans import (
     RETREAT_AFTER,
     STATE_REFUSALS,
     Step,
     TaskRefused,
     get_plan,
-    labware_id_at_source,
+    label_at_source,
     put_plan,
     retreat_steps,
+    source_of,
 )
 from tiago_sim.sequencer.postconditions import topic_of, unmet
 from tiago_sim.sequencer.step_durations import StepDurations, table_from_parameters
@@ -83,7 +87,7 @@ SUB_ACTIONS = {
 TIMEOUT_CODES = {"navigate": ErrorCodes.NAVIGATION_FAILED, "undock": ErrorCodes.NAVIGATION_FAILED}
 PARAMETERS = tuple(  # every one in sequencer.yaml, besides estimates_s
     "arm feedback_hz server_wait_s step_timeout_s cancel_wait_s post_check_s describe_timeout_s "
-    "describe_attempts state_max_age_s".split()
+    "describe_attempts state_max_age_s label_checks".split()
 )
 STATE_TOPICS = {"robot": "/robot_state", "stations": "/station_states"}
 
@@ -91,7 +95,7 @@ STATE_TOPICS = {"robot": "/robot_state", "stations": "/station_states"}
 class Sequencer:
     """The node's behaviour: two task action servers over the robot's action clients."""
 
-    def __init__(self, node: Node, params: dict[str, Any]) -> None:
+    def __init__(self, node: Node, params: dict[str, Any], inventory_file: Path | None = None) -> None:
         self.node = node
         for name in PARAMETERS:
             node.declare_parameter(name, params[name])
@@ -110,6 +114,8 @@ class Sequencer:
         node.create_subscription(RobotState, "/robot_state", self._on_robot_state, qos)
         node.create_subscription(StationStates, "/station_states", self._on_station_states, qos)
         self.active: TaskRun | None = None
+        self.inventory = InventoryKeeper(node, inventory_file)
+        self.task_ended_at = -1e9  # the book follows the sensors only with reports read after it
         self.answering: set[str] = set()  # action servers known to answer (waits.wait_answering)
         self.step_durations = StepDurations({})  # robot seconds per step kind, learned as steps run
         for kind, topic, plan in (
@@ -137,11 +143,23 @@ class Sequencer:
         if message.state not in (RobotState.STATE_MANIPULATING, RobotState.STATE_NAVIGATING):
             self.idle_report_at = self.state_times["robot"]
         self._report_in()
+        self._follow_sensors()
 
     def _on_station_states(self, message: StationStates) -> None:
         self.station_states = message
         self.state_times["stations"] = time.monotonic()
         self._report_in()
+        self._follow_sensors()
+
+    def _follow_sensors(self) -> None:
+        """Between transfers, the inventory follows the sensors (a plate taken away by hand, the lab
+        reset): only with both reports received after the last transfer ended, which settled its
+        plate itself from the reports its post-conditions read."""
+        if self.active is not None or len(self.state_times) < 2:
+            return
+        if min(self.state_times.values()) <= self.task_ended_at:
+            return
+        self.inventory.reconcile(self.robot_state, self.station_states)
 
     def _report_in(self) -> None:
         if not self.report_arrived.done():
@@ -205,16 +223,18 @@ class Sequencer:
     def _execute(self, kind: Any, make_plan: Any) -> Any:
         async def execute(goal_handle: Any) -> Any:
             result = kind.Result()
-            result.labware_id = goal_handle.request.labware_id
+            request = goal_handle.request
+            result.labware_id = request.labware_id
             if self.active is not None:
                 return self._finish(goal_handle, result, ErrorCodes.BUSY, "busy with another transfer")
+            source = source_of(request, kind is PutLabware)
             try:
-                plan = await self._plan(goal_handle.request, make_plan, arrived=time.monotonic())
+                plan = await self._plan(request, make_plan, arrived=time.monotonic())
+                label = label_at_source(request, self.robot_state, self.station_states, kind is PutLabware)
+                result.labware_id = self._name_plate(request, source, label)
             except (TaskRefused, StepFailed) as refusal:
                 return self._finish(goal_handle, result, refusal.code, refusal.message)
-            result.labware_id = labware_id_at_source(
-                goal_handle.request, self.robot_state, self.station_states, kind is PutLabware
-            )
+            destination = source_of(request, kind is GetLabware)
             self.step_durations.table = table_from_parameters(
                 {key: float(self.param(f"estimates_s.{key}")) for key in self.estimate_keys}
             )
@@ -234,7 +254,7 @@ class Sequencer:
                     run.publish()  # a new phase is news: clients see it at once, not at the next tick
                     started = self._robot_seconds()  # a step's time counts its check: clients wait for both
                     await self._run_step(run, step, f"step {index + 1} of {len(plan)}")
-                    await self._check_post(step, result.labware_id)
+                    await self._check_post(step, label)
                     self.step_durations.record(step, self._robot_seconds() - started, run.task)
                 run.index, run.phase = len(plan), "done"
                 run.publish()  # the last word is progress 1.0
@@ -246,10 +266,30 @@ class Sequencer:
             except Exception as error:  # noqa: BLE001 - every goal ends with a result
                 log.exception("task failed")
                 return self._finish(goal_handle, result, ErrorCodes.INTERNAL, f"internal error: {error}")
-            finally:
+            finally:  # before the result leaves (rclpy sends it once this coroutine returns)
+                self.inventory.settle(
+                    result.labware_id, (destination, GRIPPER, source), self.robot_state, self.station_states
+                )
+                result.inventory_revision = self.inventory.revision
+                self.task_ended_at = time.monotonic()
                 self.active = None
 
         return execute
+
+    def _name_plate(self, request: Any, source: Any, label: str) -> str:
+        """Name the goal's plate before anything moves (labware_model.inventory): the goal's id,
+        else the name the inventory has for the plate at the source, else its label. A label that
+        reads other than the goal's id is noted, and refused only with `label_checks` on."""
+        name = request.labware_id
+        if name and label and name != label and bool(self.param("label_checks")):
+            raise TaskRefused(
+                ErrorCodes.LABEL_MISMATCH,
+                f"label checks are on: the plate at {source} reads {label!r}, not {name!r}",
+            )
+        try:
+            return self.inventory.name_plate(source, name, request.labware_type, label)
+        except NameTaken as taken:
+            raise TaskRefused(ErrorCodes.LABWARE_ELSEWHERE, str(taken)) from taken
 
     async def _retreat(self, run: TaskRun, plan: list[Step]) -> None:
         """Best effort after the gripper was left empty: bring the arm out of the nest or pocket and
@@ -382,13 +422,25 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--params", type=Path, default=DEFAULT_PARAMS, help="parameter YAML (default: %(default)s)"
     )
+    parser.add_argument(
+        "--inventory",
+        type=Path,
+        default=None,
+        help="file that keeps the labware inventory across restarts (default: kept in memory only)",
+    )
+    parser.add_argument(
+        "--label-checks",
+        action="store_true",
+        help="refuse a transfer whose plate's label reads other than the goal's labware id",
+    )
     parser.add_argument("--log-level", default="INFO")
     args = parser.parse_args(argv)
     logging.basicConfig(level=args.log_level, format="%(asctime)s %(levelname)s %(name)s: %(message)s")
     params = load_params(args.params)
+    params["label_checks"] = bool(params["label_checks"]) or args.label_checks
 
     def build(node: Node) -> Sequencer:
-        sequencer = Sequencer(node, params)
+        sequencer = Sequencer(node, params, args.inventory)
         log.info("sequencer ready")
         return sequencer
 

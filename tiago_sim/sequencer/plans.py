@@ -113,18 +113,24 @@ def hotel_slot_state(robot_state: Any, slot: HotelSlot) -> Any | None:
     return None
 
 
-def labware_id_at_source(request: Any, robot_state: Any, station_states: Any, from_hotel: bool) -> str:
-    """The plate's id as the robot's sensors report it at the source (the goal's hotel slot, or its
-    nest), else the one the goal asked for."""
+def source_of(request: Any, from_hotel: bool) -> HotelSlot | Nest:
+    """Where a goal takes its plate from: its hotel slot (PutLabware) or its nest (GetLabware)."""
+    if from_hotel:
+        return HotelSlot(request.internal_position)
+    return Nest(request.handover_position, request.sub_position)
+
+
+def label_at_source(request: Any, robot_state: Any, station_states: Any, from_hotel: bool) -> str:
+    """The label the source's reader reads off the goal's plate ("" where none was read): the
+    plate's physical identity, which the post-conditions compare with what later readers read. The
+    goal's id is a name, not a label (see labware_model.inventory)."""
     if from_hotel and robot_state is not None:
         slot = hotel_slot_state(robot_state, HotelSlot(request.internal_position))
-        if slot is not None and slot.labware_id:
-            return slot.labware_id
+        return slot.labware_id if slot is not None else ""
     if not from_hotel and station_states is not None:
         nest = nest_state(station_states, Nest(request.handover_position, request.sub_position))
-        if nest is not None and nest.labware_id:
-            return nest.labware_id
-    return request.labware_id
+        return nest.labware_id if nest is not None else ""
+    return ""
 
 
 def travel_steps(robot_state: Any, poi: str) -> list[Step]:

@@ -12,6 +12,7 @@ import inspect
 import threading
 import time
 from collections.abc import Callable
+from dataclasses import replace
 
 import pytest
 
@@ -90,7 +91,7 @@ def until_true(attempt: Callable[[], bool], timeout_s: float = 1.0) -> None:
 @pytest.mark.parametrize("backend", [RobotLink, FakeRobot], ids=["RobotLink", "FakeRobot"])
 def test_the_link_and_the_fake_have_the_protocols_signatures(backend: type) -> None:
     members = [name for name in dir(RobotBackend) if not name.startswith("_")]
-    assert len(members) == 10, members
+    assert len(members) == 13, members
     for name in members:
         assert inspect.signature(getattr(backend, name)) == inspect.signature(getattr(RobotBackend, name)), (
             name
@@ -313,6 +314,36 @@ def test_a_failed_put_that_dropped_the_plate_records_it_lost() -> None:
     assert controller.inventory.locate("P1").location == UNKNOWN
 
 
+# --- the scheduler's ids are names; the sensors say where ---
+
+
+def test_a_scheduler_id_names_the_plate_whatever_its_label_reads() -> None:
+    fake = at_reader_with_plate("plate_001")  # the plate's label, which the scheduler does not know
+    controller = controller_on(fake)
+    controller.prepare_for_input("reader", 1, 2, "plate_96", "p1")
+    assert controller.get_labware("reader", 1, []) == "p1"
+    record = controller.inventory.locate("p1")
+    assert (record.location, record.label) == (HotelSlot(2), "plate_001")
+    assert record.note == "its label reads 'plate_001', not 'p1'"
+    assert controller.inventory.locate("plate_001") is None, "one plate, one name"
+    fake.set_robot_status(replace(fake.robot_status(), current_poi="rack_poi"))
+    controller.prepare_for_output("rack", 2, 2)
+    assert controller.put_labware("rack", 2, []) == "p1"
+    assert controller.inventory.locate("p1").location == Nest("rack", 2)
+
+
+def test_an_id_aboard_or_at_another_nest_is_refused_at_prepare_for_input() -> None:
+    fake = at_reader_with_plate("plate_001")
+    controller = controller_on(fake)
+    controller.prepare_for_input("reader", 1, 1, "", "p1")
+    controller.get_labware("reader", 1, [])
+    fake.set_nests((nest("reader", 1, "plate_002"), nest("rack", 2)))
+    with pytest.raises(CommandSequenceError, match="labware 'p1' is already aboard, not at reader/1"):
+        controller.prepare_for_input("reader", 1, 2, "", "p1")
+    assert fake.actions_sent() == ["get_labware"], "a refusal moves nothing"
+    controller.prepare_for_input("reader", 1, 2, "", "p2")  # another name is fine
+
+
 # --- a success the sensors do not show is a failure ---
 
 
@@ -326,8 +357,8 @@ def test_a_get_reported_done_with_the_plate_not_in_its_slot_fails_and_records_wh
         controller.get_labware("reader", 1, [])
     assert failed.value.error_code == "PLATE_SLIPPED"
     assert failed.value.message == (
-        "GetLabware failed (PLATE_SLIPPED): the robot side reported success, but the sensors put P1 "
-        "at gripper, not hotel:1"
+        "GetLabware failed (PLATE_SLIPPED): the robot side reported success, but the sensor of "
+        "hotel slot 1 sees no plate; the inventory has it at gripper"
     )
     assert controller.inventory.locate("P1").location == GRIPPER
     assert controller.sequence.phase.value == "idle"
@@ -345,8 +376,8 @@ def test_a_put_reported_done_with_an_empty_nest_fails_and_records_the_plate_lost
         controller.put_labware("rack", 2, [])
     assert failed.value.error_code == "PLACE_FAILED"
     assert failed.value.message == (
-        "PutLabware failed (PLACE_FAILED): the robot side reported success, but the sensors put P1 "
-        "at nowhere a sensor sees, not station:rack:2"
+        "PutLabware failed (PLACE_FAILED): the robot side reported success, but the sensor of "
+        "rack/2 sees no plate"
     )
     assert controller.inventory.locate("P1").location == UNKNOWN
 

@@ -6,11 +6,12 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from labware_model.holders import GRIPPER, UNKNOWN, HotelSlot, Nest
-from labware_model.readings import HotelSlotReading, NestReading
-from ros_bridge.workcell import RobotStatus
+from labware_model.holders import UNKNOWN, HotelSlot, Nest
+from labware_model.inventory import LabwareRecord
+from labware_model.readings import HotelSlotReading
+from ros_bridge.workcell import InventorySnapshot, RobotStatus
 from sila_labware.device.errors import CommandSequenceError, ParameterError
-from sila_labware.device.inventory import Inventory, observed_location
+from sila_labware.device.inventory import Inventory
 from sila_labware.device.sequences import (
     ManipulatorPhase,
     ManipulatorSequence,
@@ -187,39 +188,15 @@ def test_parameter_errors_name_the_problem() -> None:
 # --- inventory ---
 
 
-def test_observed_location_prefers_robot_reports_then_nest_sensors() -> None:
-    nests = (NestReading(READER, True, ""), NestReading(RACK_2, True, "P9"))
-    assert observed_location("P1", READER, robot_status({1: "P1", 2: ""}), nests) == HotelSlot(1)
-    assert observed_location("P1", READER, robot_status(held="P1"), nests) == GRIPPER
-    assert observed_location("P9", READER, robot_status(), nests) == RACK_2
-    assert observed_location("P1", READER, robot_status(), nests) == READER
-    assert observed_location("P1", RACK_2, robot_status(), (NestReading(RACK_2, False, ""),)) == UNKNOWN
-
-
-def test_a_plate_whose_label_was_not_read_is_where_its_transfer_put_it() -> None:
-    unread_slot = (HotelSlotReading(HotelSlot(1), "", "", occupied=True), HotelSlotReading(HotelSlot(2)))
-    stowed = RobotStatus("idle", "", "", 0.0, 0.0, 0.0, unread_slot, "")
-    empty_nest = (NestReading(READER, False, ""),)
-    # after a GetLabware into slot 1: the slot sees a plate it could not read, and it is the one moved
-    assert observed_location("P1", READER, stowed, empty_nest, HotelSlot(1)) == HotelSlot(1)
-    assert observed_location("P1", READER, stowed, empty_nest, HotelSlot(2)) == UNKNOWN
-    held = RobotStatus("idle", "", "", 0.0, 0.0, 0.0, (), "", holding=True)
-    assert observed_location("P1", READER, held, empty_nest, HotelSlot(1)) == GRIPPER
-    assert observed_location("P1", None, held, empty_nest) == UNKNOWN  # no transfer: no guess
-
-
-def test_inventory_stays_true_on_failure_and_notifies_changes() -> None:
+def test_the_mirror_takes_the_robot_sides_inventory_and_tells_only_changes() -> None:
     inventory = Inventory()
-    snapshots: list[int] = []
-    inventory.add_listener(lambda records: snapshots.append(len(records)))
-    inventory.record("P1", "plate", READER)
-    # A GetLabware that failed before the grasp: the reader's sensor still sees the plate.
-    where = inventory.settle("P1", "", READER, robot_status(), (NestReading(READER, True, ""),))
-    assert where == READER and inventory.locate("P1").labware_type == "plate"
-    # A GetLabware that dropped the plate: neither robot nor nest has it.
-    assert inventory.settle("P1", "", READER, robot_status(), (NestReading(READER, False, ""),)) == UNKNOWN
-    inventory.observe_robot(robot_status({1: "", 2: "P2"}))
+    heard: list[tuple[str, ...]] = []
+    inventory.add_listener(lambda records: heard.append(tuple(r.labware_id for r in records)))
+    records = (LabwareRecord("P1", "plate", READER), LabwareRecord("P2", "", HotelSlot(2)))
+    inventory.replace(InventorySnapshot(7, records))
+    inventory.replace(InventorySnapshot(8, records))  # a new revision of the same records
+    assert heard == [("P1", "P2")] and inventory.revision == 8
     assert inventory.in_hotel_slot(2).labware_id == "P2" and inventory.in_hotel_slot(1) is None
-    assert [record.labware_id for record in inventory.records()] == ["P1", "P2"]
-    assert snapshots == [1, 1, 2]  # the settle that changed nothing notified nobody
-    assert inventory.locate("P3") is None
+    assert inventory.at(READER).labware_id == "P1" and inventory.locate("P3") is None
+    inventory.mark_all_unknown()  # the robot side is gone: no sensor vouches for any plate
+    assert {r.location for r in inventory.records()} == {UNKNOWN} and len(heard) == 2

@@ -1,0 +1,135 @@
+"""The robot side's one inventory: a `LabwareBook` kept on the sequencer's thread, published on
+/labware_inventory and written to a file that outlives a restart of the robot side.
+
+Why in the sequencer: every transfer, whichever door it came through (a SiLA server, the Bluesky
+device, a plain ROS client), is a goal of this node, and the sensors it settles them on are the
+robot's. Readers (the bridge's RobotLink, the Bluesky device) mirror the published records.
+
+Threads: the sequencer's executor thread only (subscription callbacks and task coroutines).
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import time
+from pathlib import Path
+from typing import Any
+
+from labware_interfaces.msg import LabwareInventory, LabwareRecord
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+
+from labware_model.holders import GRIPPER, HotelSlot, Location, Nest, location_text
+from labware_model.inventory import LabwareBook, SensedPlate, sensed_plates
+from labware_model.readings import HotelSlotReading, NestReading
+
+log = logging.getLogger("tiago_sim.sequencer.inventory")
+
+INVENTORY_TOPIC = "/labware_inventory"
+REPUBLISH_PERIOD_S = 1.0
+INVENTORY_QOS = QoSProfile(
+    depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
+)
+
+
+def hotel_readings(robot_state: Any) -> tuple[HotelSlotReading, ...]:
+    return tuple(
+        HotelSlotReading(HotelSlot(int(s.index)), s.labware_id, s.labware_type, bool(s.occupied))
+        for s in robot_state.hotel
+    )
+
+
+def nest_readings(station_states: Any) -> tuple[NestReading, ...]:
+    return tuple(
+        NestReading(Nest(n.station, int(n.sub_position)), bool(n.occupied), n.labware_id)
+        for n in station_states.nests
+    )
+
+
+def sensed_now(robot_state: Any, station_states: Any) -> tuple[tuple[SensedPlate, ...], set[Location]]:
+    """What the sensors see, and every holder that has a sensor, from one pair of state messages."""
+    hotel, nests = hotel_readings(robot_state), nest_readings(station_states)
+    plates = sensed_plates(hotel, bool(robot_state.holding), robot_state.held_labware_id, nests)
+    holders: set[Location] = {r.slot for r in hotel} | {r.nest for r in nests} | {GRIPPER}
+    return plates, holders
+
+
+class InventoryKeeper:
+    """The book, its topic and its file. `changed()` after every edit publishes and saves."""
+
+    def __init__(self, node: Node, path: Path | None) -> None:
+        self.node = node
+        self.path = path
+        self.book = self._load(path)
+        # Grows across restarts too: a reader compares a goal's revision with the latest it has.
+        self.revision = time.time_ns() // 1000
+        self.publisher = node.create_publisher(LabwareInventory, INVENTORY_TOPIC, INVENTORY_QOS)
+        node.create_timer(REPUBLISH_PERIOD_S, self.publish)
+        self.publish()
+
+    @staticmethod
+    def _load(path: Path | None) -> LabwareBook:
+        if path is None or not path.exists():
+            return LabwareBook()
+        try:
+            book = LabwareBook.from_json(path.read_text())
+        except (OSError, ValueError) as error:
+            log.error("inventory file %s not read (%s): starting from the sensors alone", path, error)
+            return LabwareBook()
+        log.info("inventory of %d plate(s) read from %s", len(book.records()), path)
+        return book
+
+    def changed(self) -> int:
+        """A new revision: published at once and saved; returns it."""
+        self.revision += 1
+        self.publish()
+        self._save()
+        return self.revision
+
+    def publish(self) -> None:
+        message = LabwareInventory(revision=self.revision)
+        message.stamp = self.node.get_clock().now().to_msg()
+        message.records = [
+            LabwareRecord(
+                labware_id=r.labware_id,
+                labware_type=r.labware_type,
+                location=location_text(r.location),
+                label=r.label,
+                note=r.note,
+            )
+            for r in self.book.records()
+        ]
+        self.publisher.publish(message)
+
+    def _save(self) -> None:
+        if self.path is None:
+            return
+        temporary = self.path.with_name(self.path.name + ".tmp")
+        try:
+            temporary.write_text(self.book.to_json())
+            os.replace(temporary, self.path)
+        except OSError as error:
+            log.error("inventory file %s not written: %s", self.path, error)
+
+    def name_plate(self, holder: Location, name: str, labware_type: str, label: str) -> str:
+        """Name the plate at `holder` for a goal (LabwareBook.name_plate); returns the name ("" for
+        an unread plate nobody named). Raises NameTaken."""
+        before = self.book.records()
+        record = self.book.name_plate(holder, name, labware_type, label)
+        if self.book.records() != before:
+            self.changed()
+        return record.labware_id if record is not None else ""
+
+    def reconcile(self, robot_state: Any, station_states: Any) -> None:
+        """Follow the sensors (between transfers only: the caller knows)."""
+        plates, holders = sensed_now(robot_state, station_states)
+        if self.book.reconcile(plates, holders):
+            self.changed()
+
+    def settle(self, name: str, candidates: tuple[Location, ...], robot_state: Any, stations: Any) -> None:
+        """After a transfer (LabwareBook.settle), from the latest reports."""
+        if name and self.book.settle(name, candidates, sensed_now(robot_state, stations)[0]):
+            record = self.book.get(name)
+            log.info("labware %s is now at %s", name, location_text(record.location) if record else "?")
+            self.changed()
