@@ -110,7 +110,7 @@ class LabwareBook:
             return None
         other = self._records.get(chosen)
         if other is not None and other is not current and other.location not in (holder, UNKNOWN):
-            raise NameTaken(f"labware {chosen!r} is at {location_text(other.location)}, not {holder}")
+            raise NameTaken(f"labware {chosen!r} is at {other.location}, not at {holder}")
         if current is not None and current.labware_id != chosen:
             del self._records[current.labware_id]
             logger.info("the plate at %s, %r until now, is named %r", holder, current.labware_id, chosen)

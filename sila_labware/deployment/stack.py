@@ -16,6 +16,8 @@ from __future__ import annotations
 
 import logging
 import os
+import shutil
+import tempfile
 import threading
 import time
 from collections.abc import Callable, Sequence
@@ -67,6 +69,12 @@ class DeploymentOptions:
     """Carried by every server name (see lab_name.py); empty: the world file's."""
     pace: float | None = None
     """Times real time the simulation runs at (see pacing.py); None: as fast as it can."""
+    inventory_file: Path | None = None
+    """Where the robot side keeps its labware inventory, so that the names a scheduler gave its
+    plates outlive a restart of the robot side; None: a file in a directory of the deployment's own."""
+    label_checks: bool = False
+    """Refuse a transfer whose plate's label reads other than the scheduler's id (the sequencer's
+    `label_checks`); off: such a plate is transferred and the difference noted."""
     prewarmed_robot_side: bool = False
     """Fork the robot side from a process that imported it once (prewarmed.py): for runs that
     start many deployments one after the other, such as a campaign's trials."""
@@ -94,13 +102,19 @@ def choose_domain_id(requested: int | None) -> int:
 
 
 def start_robot_side(
-    children: ProcessGroup, world: Path, extra_sim_arguments: Sequence[str] = (), pace: float | None = None
+    children: ProcessGroup,
+    world: Path,
+    extra_sim_arguments: Sequence[str] = (),
+    pace: float | None = None,
+    sequencer_arguments: Sequence[str] = (),
 ) -> None:
     """Start the robot side's ROS nodes (simulation node, sequencer) as children."""
     for name, module in ROBOT_SIDE_MODULES:
         arguments = ["--world", str(world)]
         if name == "sim_node":
             arguments += [*sim_pace_arguments(pace), *extra_sim_arguments]
+        else:
+            arguments += sequencer_arguments
         children.start_python_module(name, module, arguments)
 
 
@@ -133,6 +147,7 @@ class Deployment:
         self.ca_file: Path | None = None
         self.supervisor: RobotSideSupervisor | None = None
         self._lifecycle_lock = threading.Lock()  # restarts (supervisor) vs. stop (caller)
+        self._inventory_file: Path | None = None
         self._stopping = False
 
     def start(self, should_stop: Callable[[], bool] = lambda: False) -> None:
@@ -158,8 +173,21 @@ class Deployment:
         with self._lifecycle_lock:
             self._refuse_if_stopping()
             start_robot_side(
-                self.children, self.options.world, self.options.extra_sim_arguments, self.options.pace
+                self.children,
+                self.options.world,
+                self.options.extra_sim_arguments,
+                self.options.pace,
+                self._sequencer_arguments(),
             )
+
+    def _sequencer_arguments(self) -> list[str]:
+        """The inventory's file (the same for every restart of this deployment), label checks."""
+        if self._inventory_file is None:
+            self._inventory_file = self.options.inventory_file or (
+                Path(tempfile.mkdtemp(prefix="sila-labware-inventory-")) / "inventory.json"
+            )
+        arguments = ["--inventory", str(self._inventory_file)]
+        return arguments + (["--label-checks"] if self.options.label_checks else [])
 
     def _new_runtime(self) -> RosRuntime:
         return RosRuntime("sila_labware_bridge", domain_id=self.domain_id).start()
@@ -275,6 +303,8 @@ class Deployment:
                 stopper.join(2.0)
             self.servers.clear()
             self.children.stop(timeout_s=max(0.0, terminated_at + CHILD_STOP_S - time.monotonic()))
+            if self._inventory_file is not None and self.options.inventory_file is None:
+                shutil.rmtree(self._inventory_file.parent, ignore_errors=True)  # our own directory
 
 
 def _stop_server(server: SilaServer) -> None:

@@ -111,13 +111,13 @@ class RobotController:
         handover = self.parameters.prepare(
             position, sub_position, internal_position, labware_type, labware_id
         )
+        self._refuse_a_name_in_use(labware_id, handover)
         occupant = self._hotel_occupant(self.link.robot_status(), internal_position)
         if occupant is not None:
             what = f"labware {occupant!r}" if occupant else "a plate nobody has named"
             raise CommandSequenceError(
                 f"PrepareForInput refused: internal position {internal_position} already holds {what}"
             )
-        self._refuse_a_name_in_use(labware_id, handover)
         transfer = PreparedTransfer(handover, internal_position, labware_type, labware_id)
         self.sequence.begin_prepare_for_input(transfer)
         self._drive_for_transfer(handover, CommandProgress(report, self.pace.to_wall_s))
@@ -329,7 +329,7 @@ class RobotController:
         record = self.inventory.locate(labware_id) if labware_id else None
         if record is None or record.location in (handover, UNKNOWN):
             return
-        where = "already aboard" if aboard(record.location) else f"at {location_text(record.location)}"
+        where = "already aboard" if aboard(record.location) else f"at {record.location}"
         raise CommandSequenceError(
             f"PrepareForInput refused: labware {labware_id!r} is {where}, not at {handover}; "
             "a labware id names one plate"

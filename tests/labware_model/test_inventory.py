@@ -62,7 +62,7 @@ def test_an_unread_plate_keeps_the_name_recorded_where_it_stands() -> None:
 
 def test_a_name_names_one_plate() -> None:
     book = LabwareBook([LabwareRecord("p1", "", SLOT1), LabwareRecord("lost", "", UNKNOWN)])
-    with pytest.raises(NameTaken, match="'p1' is at hotel:1"):
+    with pytest.raises(NameTaken, match="'p1' is at hotel slot 1"):
         book.name_plate(A1, "p1", "", "")
     assert book.name_plate(A1, "lost", "", "").location == A1  # a lost plate found again
     assert book.name_plate(SLOT1, "p1", "", "").location == SLOT1  # the plate it names
