@@ -62,6 +62,7 @@ class InventoryKeeper:
         self.node = node
         self.path = path
         self.book = self._load(path)
+        self.followed_sensors = False  # nothing is published before the sensors were read once
         # Grows across restarts too: a reader compares a goal's revision with the latest it has.
         self.revision = time.time_ns() // 1000
         self.publisher = node.create_publisher(LabwareInventory, INVENTORY_TOPIC, INVENTORY_QOS)
@@ -88,6 +89,10 @@ class InventoryKeeper:
         return self.revision
 
     def publish(self) -> None:
+        """Send the book as it is; not before it has followed the sensors once (a book read from
+        the file may name places a restart emptied: readers get the checked one first)."""
+        if not self.followed_sensors:
+            return
         message = LabwareInventory(revision=self.revision)
         message.stamp = self.node.get_clock().now().to_msg()
         message.records = [
@@ -124,7 +129,8 @@ class InventoryKeeper:
     def reconcile(self, robot_state: Any, station_states: Any) -> None:
         """Follow the sensors (between transfers only: the caller knows)."""
         plates, holders = sensed_now(robot_state, station_states)
-        if self.book.reconcile(plates, holders):
+        if self.book.reconcile(plates, holders) or not self.followed_sensors:
+            self.followed_sensors = True
             self.changed()
 
     def settle(self, name: str, candidates: tuple[Location, ...], robot_state: Any, stations: Any) -> None:

@@ -3,7 +3,9 @@
 The SiLA command must end with a defined error within 10 s, every SiLA server must keep
 answering, RobotState must say Error, the inventory must not keep a stale guess, and once the
 supervisor has restarted the robot side the interrupted transfer completes (the source station is
-still prepared for output, so the scheduler resumes with the robot's part).
+still prepared for output, so the scheduler resumes with the robot's part). The scheduler names
+the plate itself: the name survives the restart, where the fresh sensors confirm the plate (its
+label, read again where the restarted simulation put it).
 """
 
 from __future__ import annotations
@@ -20,7 +22,8 @@ from sila_labware.deployment.stack import Deployment
 from tests.helpers.sila_stack import start_stack
 from tests.helpers.transfer_steps import Cell, finish, wait_for_progress
 
-PLATE = "plate_001"
+PLATE = "scheduler-plate-7"
+"""The scheduler's name for the plate whose label reads plate_001."""
 KILL_AT_PROGRESS = 0.35
 """GetLabware past its final approach: the arm is on its way to the plate."""
 A1, B1 = ("station_a", 1), ("station_b", 1)

@@ -206,9 +206,13 @@ def test_bad_inputs_are_named_and_change_nothing(robot: SilaClient, station_a: S
     # The server is still up and nothing moved or was recorded.
     assert manipulator.NumberOfInternalPositions.get() == 2
     assert robot.MobileRobotController.RobotState.get() == "Docked"
-    assert robot.LabwareInventory.LabwareLocations.get() == []
+    # the inventory knows the plate its sensors see, by its label, and no name the bad inputs used
+    locations = robot.LabwareInventory.LabwareLocations.get()
+    assert [(item.LabwareUniqueID, item.Aboard, item.Position, item.Index) for item in locations] == [
+        ("plate_001", False, "station_a", 1)
+    ]
     with pytest.raises(DefinedExecutionError) as caught:
-        robot.LabwareInventory.LocateLabware(LabwareUniqueID="plate_001")
+        robot.LabwareInventory.LocateLabware(LabwareUniqueID="p")
     assert caught.value.identifier == "UnknownLabware"
 
 

@@ -16,6 +16,7 @@ from sila2.server import MetadataDict, ObservableCommandInstance
 
 from ros_bridge.workcell import RobotStatus
 from sila_labware.device.errors import CommandSequenceError, MotionFailed, ParameterError
+from sila_labware.device.inventory import Inventory
 from sila_labware.servers.sila_glue import progress_reporter, validation_error
 
 from ..generated.mobilerobotcontroller import (
@@ -49,17 +50,22 @@ SILA_ROBOT_STATES = {
 }
 
 
-def onboard_items(status: RobotStatus) -> list[dict[str, object]]:
-    """OnboardLabware: one entry per occupied hotel slot, in slot order."""
-    return [
-        {
-            "InternalPosition": reading.slot.index,
-            "LabwareUniqueID": reading.labware_id,
-            "LabwareType": reading.labware_type,
-        }
-        for reading in sorted(status.hotel, key=lambda reading: reading.slot)
-        if reading.labware_id
-    ]
+def onboard_items(status: RobotStatus, inventory: Inventory) -> list[dict[str, object]]:
+    """OnboardLabware: one entry per hotel slot whose sensor sees a plate, in slot order, by the
+    name the robot side's inventory gives it ("" for a plate nobody named)."""
+    items = []
+    for reading in sorted(status.hotel, key=lambda reading: reading.slot):
+        if not reading.occupied:
+            continue
+        record = inventory.at(reading.slot)
+        items.append(
+            {
+                "InternalPosition": reading.slot.index,
+                "LabwareUniqueID": record.labware_id if record else "",
+                "LabwareType": (record.labware_type if record else "") or reading.labware_type,
+            }
+        )
+    return items
 
 
 class MobileRobotControllerImpl(MobileRobotControllerBase):
@@ -70,12 +76,18 @@ class MobileRobotControllerImpl(MobileRobotControllerBase):
         # Subscribers wait forever without a first value: publish the current state now.
         self._publish_status(self.robot.link.robot_status())
         self.robot.link.on_robot_status(self._publish_status)
+        self.robot.inventory.add_listener(
+            lambda _records: self._publish_onboard(self.robot.link.robot_status())
+        )
 
     def _publish_status(self, status: RobotStatus) -> None:
         self.update_RobotPose({"X": status.x_m, "Y": status.y_m, "Theta": status.theta_rad})
         self.update_RobotState(SILA_ROBOT_STATES.get(status.state, "Error"))
         self.update_CurrentPointOfInterest(status.current_poi[:255])
-        self.update_OnboardLabware(onboard_items(status))
+        self._publish_onboard(status)
+
+    def _publish_onboard(self, status: RobotStatus) -> None:
+        self.update_OnboardLabware(onboard_items(status, self.robot.inventory))
 
     def get_PointsOfInterest(self, *, metadata: MetadataDict) -> list[PointOfInterestName]:
         return list(self.robot.workcell.pois)

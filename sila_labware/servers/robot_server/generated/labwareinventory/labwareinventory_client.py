@@ -21,10 +21,12 @@ if TYPE_CHECKING:
 class LabwareInventoryClient:
     """
 
-    Tells where each labware item this device has handled is now, by the identifier the controlling
-    system gave it in "Prepare For Input". An item is either aboard the device (in one of its internal
-    positions) or at the handover position where the device last put it down. Items the device has never
-    touched are not known here.
+    Tells where each labware item this device knows is now: by the identifier the controlling system
+    gave it in "Prepare For Input", or, for an item no controlling system has named yet, by the label
+    the device's reader read off it. Where an item is follows the device's presence sensors: aboard
+    (in one of its internal positions) or at a handover position. A label that reads other than the
+    identifier never moves an item. Every client of the device, whatever interface it uses, sees this
+    one inventory.
 
     """
 
