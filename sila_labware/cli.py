@@ -11,19 +11,21 @@ Exit codes: 0 success, 1 the demo transfer failed or the stack could not start (
 file is invalid), 2 bad usage (an invalid world file included: every command with --world checks it
 first), 130 `demo` or `bench` stopped by Ctrl-C or SIGTERM.
 
+Machine-readable output: with `--json` (or `serve --print-config json`) stdout carries exactly one
+JSON object whatever happens, usage errors included, with `success`, `error`, `error_kind` and
+`exit_code` (deployment/json_outcome); the one-line reason is on stderr as without it.
+
 Stopping and clean-up: Ctrl-C (or SIGTERM) stops `serve`, `demo` and `bench` at any point, start-up
 included, within 5 s: the running transfer is abandoned (the robot is told to stop), the SiLA
 servers, the bridge and the robot side's processes (in their own sessions, so a terminal's Ctrl-C
 never reaches them) are stopped, and a second Ctrl-C does not cut that short. What a run creates
 in the temp folder (the `sila-labware-demo-*` / `sila-labware-bench-*` directory holding the run's
-CA file) is removed on success, failure and Ctrl-C. `demo --json` always prints one JSON object,
-with `success: false` and `error` when start-up failed or the run was stopped.
+CA file) is removed on success, failure and Ctrl-C.
 """
 
 from __future__ import annotations
 
 import argparse
-import json
 import logging
 import signal
 import sys
@@ -42,7 +44,10 @@ from sila_labware.benchmarks.campaign_cli import (
     validate_bench,
     write_recorded_pictures,
 )
+from sila_labware.deployment import json_outcome
+from sila_labware.deployment.cli_arguments import add_robot_side_arguments, add_stack_arguments
 from sila_labware.deployment.connection_config import add_print_config_argument, print_servers, write_config
+from sila_labware.deployment.json_outcome import JsonOutput, UsageError, outcome_fields
 from sila_labware.deployment.pacing import add_pace_argument, pace_problem
 from sila_labware.deployment.world_file import add_world_command, world_command, world_problems
 from sila_labware.servers.refusal_log import install_refusal_log_filter
@@ -57,10 +62,12 @@ DEFAULT_WORLD = Path(__file__).resolve().parents[1] / "tiago_sim" / "worlds" / "
 
 
 class _Parser(argparse.ArgumentParser):
-    """argparse, but usage errors are one line: `sila-labware: error: <reason>`."""
+    """argparse, but usage errors are one line, `sila-labware: error: <reason>`, and raise
+    UsageError (exit 2) so that `main` can add the JSON object a `--json` run promises."""
 
     def error(self, message: str) -> None:  # type: ignore[override]
-        self.exit(2, f"{self.prog}: error: {message}\n")
+        sys.stderr.write(f"{self.prog}: error: {message}\n")
+        raise UsageError(message)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -71,58 +78,16 @@ def build_parser() -> argparse.ArgumentParser:
         dest="command", required=True, metavar="{serve,demo,bluesky-demo,bench,world}", parser_class=_Parser
     )
 
-    def add_stack_options(sub: argparse.ArgumentParser) -> None:
-        sub.add_argument(
-            "--world", type=Path, default=DEFAULT_WORLD, help="world YAML (default: the bundled lab)"
-        )
-        sub.add_argument(
-            "--host", default="127.0.0.1", help="address the SiLA servers bind (default: %(default)s)"
-        )
-        sub.add_argument(
-            "--port-base",
-            type=int,
-            default=50052,
-            help="robot server port; stations follow (default: %(default)s)",
-        )
-        sub.add_argument(
-            "--insecure", action="store_true", help="no TLS (tests only; the standard forbids it)"
-        )
-        sub.add_argument(
-            "--ca-file",
-            type=Path,
-            default=None,
-            help="where to write the CA certificate clients trust "
-            "(default: ./sila-labware-ca.pem for serve; for demo and bench a temporary file, "
-            "removed at the end)",
-        )
-        sub.add_argument("--no-discovery", action="store_true", help="do not announce the servers (mDNS)")
-        sub.add_argument(
-            "--name",
-            default="",
-            help="the lab's name, carried by every server name so that two labs on one network are told "
-            "apart (default: the world file's `name`, else its file name)",
-        )
-        sub.add_argument(
-            "--domain-id", type=int, default=None, help="ROS domain (default: $ROS_DOMAIN_ID or random)"
-        )
-        sub.add_argument(
-            "--log-dir", type=Path, default=None, help="write the robot side's output to files here"
-        )
-        sub.add_argument(
-            "--ready-timeout", type=float, default=180.0, help="seconds to wait for the robot side"
-        )
-        sub.add_argument("--verbose", action="store_true", help="log at INFO level")
-
     serve = subcommands.add_parser(
         "serve", help="run the simulated robot and serve it and its stations over SiLA"
     )
-    add_stack_options(serve)
+    add_stack_arguments(serve, DEFAULT_WORLD)
     add_pace_argument(serve)
     add_print_config_argument(serve)
     demo = subcommands.add_parser(
         "demo", help="serve, then move the plate from the first station to the second"
     )
-    add_stack_options(demo)
+    add_stack_arguments(demo, DEFAULT_WORLD)
     add_pace_argument(demo)
     demo.add_argument(
         "--json", action="store_true", help="print one JSON object with the outcome and timings"
@@ -131,26 +96,13 @@ def build_parser() -> argparse.ArgumentParser:
         "--record", type=Path, default=None, metavar="DIR", help="write pictures of the run here"
     )
     bench = subcommands.add_parser("bench", help="repeat the demo transfer under seeded disturbances")
-    add_stack_options(bench)
+    add_stack_arguments(bench, DEFAULT_WORLD)
     add_bench_arguments(bench)
     bluesky = subcommands.add_parser(
         "bluesky-demo",
         help="run the robot side and a Bluesky plan: pickup, place, measure, return the plate",
     )
-    bluesky.add_argument(
-        "--world", type=Path, default=DEFAULT_WORLD, help="world YAML (default: the bundled lab)"
-    )
-    bluesky.add_argument(
-        "--domain-id", type=int, default=None, help="ROS domain (default: $ROS_DOMAIN_ID or random)"
-    )
-    bluesky.add_argument(
-        "--log-dir", type=Path, default=None, help="write the robot side's output to files here"
-    )
-    bluesky.add_argument(
-        "--ready-timeout", type=float, default=180.0, help="seconds to wait for the robot side"
-    )
-    bluesky.add_argument("--verbose", action="store_true", help="log at INFO level")
-    bluesky.set_defaults(port_base=50052)
+    add_robot_side_arguments(bluesky, DEFAULT_WORLD)
     add_world_command(subcommands, _Parser)
     return parser
 
@@ -240,8 +192,8 @@ def _interrupt_on_signals() -> None:
 
 
 def _start(args: argparse.Namespace) -> tuple[Deployment | None, _StopRequest]:
-    """Start the deployment; None if it could not start (the reason is on stderr) or was stopped
-    while starting (then the stop request is set)."""
+    """Start the deployment; None if it could not start (the reason is on stderr, and on stdout as
+    JSON with --print-config) or was stopped while starting (then the stop request is set)."""
     from sila_labware.deployment.stack import Deployment
 
     stop = _StopRequest()
@@ -251,10 +203,16 @@ def _start(args: argparse.Namespace) -> tuple[Deployment | None, _StopRequest]:
         deployment.start(should_stop=stop.event.is_set)
     except KeyboardInterrupt:
         stop.event.set()
+        if args.print_config:
+            JsonOutput.write_failure(
+                "interrupted (SIGINT or SIGTERM) while starting", json_outcome.INTERRUPTED, 0
+            )
         return None, stop
     except Exception as error:  # noqa: BLE001 - one line for the user, details in the log
         logger.debug("start failed", exc_info=True)
         sys.stderr.write(f"sila-labware: could not start: {error}\n")
+        if args.print_config:
+            JsonOutput.write_failure(f"could not start: {error}", json_outcome.START_FAILED, 1)
         return None, stop
     return deployment, stop
 
@@ -291,8 +249,17 @@ def demo(args: argparse.Namespace) -> int:
             ending = _INTERRUPTED
     for stop_signal in (signal.SIGINT, signal.SIGTERM):  # the outcome is printed whole
         signal.signal(stop_signal, signal.SIG_IGN)
+    exit_code = INTERRUPTED_EXIT_CODE if ending == _INTERRUPTED else 0 if report.success else 1
     if args.json:
-        sys.stdout.write(json.dumps(report.as_json_object()) + "\n")
+        if ending == _INTERRUPTED and not report.error:  # delivered, then stopped writing the pictures
+            report.success, report.error = False, "interrupted (SIGINT or SIGTERM) while writing the pictures"
+        kind = {_INTERRUPTED: json_outcome.INTERRUPTED, _NOT_STARTED: json_outcome.START_FAILED}.get(
+            ending, json_outcome.FAILED
+        )
+        error = "" if report.success else report.error or "the plate was not delivered"
+        JsonOutput.write(
+            {**report.as_json_object(), **outcome_fields(error, kind if error else "", exit_code)}
+        )
     elif ending != _NOT_STARTED:  # a start-up failure is the one line on stderr
         outcome = "plate delivered" if report.success else f"FAILED: {report.error}"
         error_mm = report.plate_position_error_mm
@@ -301,9 +268,7 @@ def demo(args: argparse.Namespace) -> int:
             f"{outcome}{detail}; {report.wall_seconds:.1f} s wall, {report.sim_seconds:.1f} s simulated\n"
         )
     sys.stdout.flush()
-    if ending == _INTERRUPTED:
-        return INTERRUPTED_EXIT_CODE
-    return 0 if report.success else 1
+    return exit_code
 
 
 _TRANSFERRED, _INTERRUPTED, _NOT_STARTED = "transferred", "interrupted", "not started"
@@ -375,9 +340,17 @@ COMMANDS = {
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    arguments = sys.argv[1:] if argv is None else list(argv)
+    as_json = json_outcome.json_requested(arguments)
+    JsonOutput.reset()
     parser = build_parser()
-    args = parser.parse_args(argv)
-    _validate(parser, args)
+    try:
+        args = parser.parse_args(arguments)
+        _validate(parser, args)
+    except UsageError as error:  # its line is on stderr already
+        if as_json:
+            JsonOutput.write_failure(error.message, json_outcome.USAGE, 2)
+        return 2
     logging.basicConfig(
         level=logging.INFO if getattr(args, "verbose", False) else logging.WARNING,
         format="%(asctime)s %(levelname)s %(name)s: %(message)s",
@@ -390,7 +363,17 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return COMMANDS[args.command](args)
     except KeyboardInterrupt:  # a further Ctrl-C after the run was stopped and cleaned up
+        if as_json:
+            JsonOutput.write_failure(
+                "interrupted (SIGINT or SIGTERM)", json_outcome.INTERRUPTED, INTERRUPTED_EXIT_CODE
+            )
         return INTERRUPTED_EXIT_CODE
+    except Exception as error:
+        if not as_json:
+            raise
+        logger.exception("%s failed", args.command)  # a bug: the traceback on stderr
+        JsonOutput.write_failure(f"{type(error).__name__}: {error}", json_outcome.INTERNAL, 1)
+        return 1
 
 
 if __name__ == "__main__":

@@ -20,6 +20,7 @@ import tempfile
 import time
 from dataclasses import asdict, replace
 from pathlib import Path
+from typing import Any
 
 from sila_labware.benchmarks.campaign import (
     LEVEL_FLAGS,
@@ -38,6 +39,8 @@ from sila_labware.benchmarks.random_layouts import (
     save_layout,
 )
 from sila_labware.benchmarks.workers import run_parallel_campaign
+from sila_labware.deployment import json_outcome
+from sila_labware.deployment.json_outcome import JsonOutput, outcome_fields
 from sila_labware.deployment.stack import DeploymentOptions
 
 logger = logging.getLogger(__name__)
@@ -146,7 +149,7 @@ def bench_command(args: argparse.Namespace, stack: DeploymentOptions) -> int:
         logging.getLogger("sila_labware").setLevel(logging.WARNING)
     if args.save_layout is not None:
         furnish = stack.world if args.random_obstacles else None
-        return save_layout_command(int(args.save_layout[0]), Path(args.save_layout[1]), furnish)
+        return save_layout_command(int(args.save_layout[0]), Path(args.save_layout[1]), furnish, args.json)
     levels = level_values(args)
     first_seed, trials = (args.replay, 1) if args.replay is not None else (args.seed, args.trials)
     frames_dir = args.report / "frames" if args.report is not None else None
@@ -162,6 +165,8 @@ def bench_command(args: argparse.Namespace, stack: DeploymentOptions) -> int:
                 options.layouts_dir = draw_layouts(first_seed, trials, Path(scratch), jobs, furnish)
             except LayoutGenerationError as error:
                 sys.stderr.write(f"bench: no random layouts: {error}\n")
+                if args.json:
+                    JsonOutput.write_failure(f"no random layouts: {error}", json_outcome.START_FAILED, 1)
                 return 1
             if args.random_obstacles:
                 options.layouts_flag = "--random-obstacles"
@@ -180,16 +185,22 @@ def draw_layouts(
     return directory
 
 
-def save_layout_command(seed: int, target: Path, furnish: Path | None = None) -> int:
+def save_layout_command(seed: int, target: Path, furnish: Path | None = None, as_json: bool = False) -> int:
+    """Write one seed's layout; with `as_json` the outcome is one JSON object (`layout`: the file)."""
     try:
         save_layout(seed, target, furnish)
     except LayoutGenerationError as error:
         sys.stderr.write(f"bench: {error}\n")
+        if as_json:
+            JsonOutput.write_failure(str(error), json_outcome.FAILED, 1)
         return 1
     what = (
         f"random layout of seed {seed}" if furnish is None else f"{furnish} with the obstacles of seed {seed}"
     )
-    sys.stdout.write(f"{target}: {what}; run it with sila-labware demo --world {target}\n")
+    if as_json:
+        JsonOutput.write({"layout": str(target), "seed": seed, **outcome_fields()})
+    else:
+        sys.stdout.write(f"{target}: {what}; run it with sila-labware demo --world {target}\n")
     return 0
 
 
@@ -236,17 +247,28 @@ def _run_and_report(args: argparse.Namespace, options: CampaignOptions) -> int:
         summary["interrupted_after_trials"] = len(outcomes)
     if args.replay is not None:
         summary["replay_repeats"] = REPLAY_REPEATS
+    all_delivered = summary["successes"] == summary["trials"]
+    exit_code = INTERRUPTED_EXIT_CODE if interrupted else 0 if all_delivered else 1
     if args.json:
-        sys.stdout.write(json.dumps(summary) + "\n")
+        JsonOutput.write({**summary, **_outcome(summary, trials, exit_code)})
     else:
         if interrupted:
             sys.stdout.write(f"interrupted: {len(outcomes)} of {trials} trial(s) done\n")
         sys.stdout.write(format_table(summary) + "\n\n" + format_targets(summary) + "\n")
         if args.replay is not None:
             sys.stdout.write(f"replayed: {REPLAY_REPEATS}\n")
-    if interrupted:
-        return INTERRUPTED_EXIT_CODE
-    return 0 if summary["successes"] == summary["trials"] else 1
+    return exit_code
+
+
+def _outcome(summary: dict[str, Any], trials: int, exit_code: int) -> dict[str, Any]:
+    """The machine-readable outcome fields (json_outcome) of a campaign's summary."""
+    if exit_code == INTERRUPTED_EXIT_CODE:
+        error = f"interrupted (SIGINT or SIGTERM) after {summary['trials']} of {trials} trial(s)"
+        return outcome_fields(error, json_outcome.INTERRUPTED, exit_code)
+    if exit_code:
+        error = f"{summary['trials'] - summary['successes']} of {summary['trials']} trial(s) failed"
+        return outcome_fields(error, json_outcome.FAILED, exit_code)
+    return outcome_fields()
 
 
 def write_recorded_pictures(record_dir: Path) -> None:

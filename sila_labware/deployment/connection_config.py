@@ -8,8 +8,9 @@ serves, and the CA file clients must trust (null when the servers run without TL
 
 from __future__ import annotations
 
-import json
 from typing import TYPE_CHECKING, Any, TextIO
+
+from sila_labware.deployment.json_outcome import JsonOutput, outcome_fields
 
 if TYPE_CHECKING:
     from sila_labware.deployment.stack import Deployment, ServedServer
@@ -54,9 +55,9 @@ def connection_config(deployment: Deployment) -> dict[str, Any]:
 
 
 def write_config(deployment: Deployment, stream: TextIO) -> None:
-    """The JSON document, on one line, flushed (a reader may wait for it line by line)."""
-    stream.write(json.dumps(connection_config(deployment)) + "\n")
-    stream.flush()
+    """The JSON document, on one line, flushed (a reader may wait for it line by line), with the
+    fields every machine-readable output carries (json_outcome; exit_code null: serve runs on)."""
+    JsonOutput.write({**connection_config(deployment), **outcome_fields(exit_code=None)}, stream)
 
 
 def print_servers(deployment: Deployment, stream: TextIO) -> None:
