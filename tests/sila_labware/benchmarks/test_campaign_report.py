@@ -15,9 +15,8 @@ import pytest
 
 from sila_labware.benchmarks.campaign import summarize
 from sila_labware.benchmarks.campaign_report import phase_chart, success_chart, write_charts
-from tests.helpers.sila_stack import REPOSITORY
 
-COMMITTED_SUMMARY = REPOSITORY / "tiago_sim" / "docs" / "campaign" / "summary.json"
+COMMITTED_SUMMARY = Path(__file__).resolve().parent / "fixtures" / "campaign_summary.json"
 
 
 @pytest.fixture(scope="module")

@@ -99,7 +99,7 @@ def test_a_poi_the_planner_cannot_reach_once_navigation_stops_off_it_is_drawn_ag
     """Random layout 83075 (kept from the campaign at 1c132be): the dispenser's POI stood 0.48 m from
     the reader's bench across an aisle; navigating to it 36 mm off, the planner found no straight way
     in along its heading. The drawing now plans to and from goals the stop error away and refuses it."""
-    kept = Path(__file__).resolve().parents[3] / "tiago_sim/docs/campaign_83000_random/layout_83075.yaml"
+    kept = Path(__file__).resolve().parent / "fixtures" / "layout_83075.yaml"
     problems = route_problems(load_world(kept))
     assert problems and all("dispenser_work 0.06 m off" in line for line in problems), problems
     assert "no straight segment along its heading" in problems[0]
