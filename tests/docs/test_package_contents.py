@@ -10,7 +10,6 @@ setuptools packages, as `pyproject.toml` configures it, and look for such output
 from __future__ import annotations
 
 import re
-from pathlib import Path
 
 from setuptools import find_namespace_packages
 
