@@ -14,9 +14,7 @@
 
 from __future__ import annotations
 
-import contextlib
 import importlib.util
-import os
 import shlex
 import shutil
 from collections.abc import Iterator
@@ -105,23 +103,15 @@ def lab(tmp_path_factory: pytest.TempPathFactory) -> Iterator[SimulatedLabSessio
         yield session
 
 
-@contextlib.contextmanager
-def in_directory(path: Path) -> Iterator[None]:
-    before = Path.cwd()
-    os.chdir(path)
-    try:
-        yield
-    finally:
-        os.chdir(before)
-
-
 def test_the_python_blocks_are_the_ones_expected() -> None:
     # a new block runs below; this count only makes a block that went missing show
     assert len(PYTHON) >= 2
 
 
 @pytest.mark.parametrize("block", PYTHON, ids=Block.where)
-def test_python_block_runs_against_the_lab(block: Block, lab: SimulatedLabSession, tmp_path: Path) -> None:
+def test_python_block_runs_against_the_lab(
+    block: Block, lab: SimulatedLabSession, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     assert lab.addresses is not None
     lab.reset()
     ports = [
@@ -133,5 +123,5 @@ def test_python_block_runs_against_the_lab(block: Block, lab: SimulatedLabSessio
     for default, actual in zip(DEFAULT_PORTS, ports, strict=True):
         code = code.replace(str(default), str(actual))
     shutil.copy(lab.addresses.ca_file, tmp_path / "sila-labware-ca.pem")
-    with in_directory(tmp_path):
-        exec(compile(code, block.where(), "exec"), {"__name__": "docs_block"})  # noqa: S102
+    monkeypatch.chdir(tmp_path)
+    exec(compile(code, block.where(), "exec"), {"__name__": "docs_block"})  # noqa: S102
