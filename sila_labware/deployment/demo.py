@@ -149,7 +149,7 @@ def plate_to_judge(link: RobotLink, read_id: str, destination: Nest) -> str:
     destination's reader read when the plate arrived there.
 
     Why: a reader misses a label 0.1 % of the time; with the source's label unread, the check asked
-    about plate "" and found it nowhere, so random layout 91072 counted a plate seated in labeler/1
+    about plate "" and found it nowhere, so a plate seated in its nest was counted
     as misplaced ("it is at unknown"). The destination was free when the transfer began, so the plate
     its reader names now is the one moved; physics still judges where it rests.
     """

@@ -9,8 +9,7 @@ geometry (tiago_sim.robot), each with its numbers:
   working pose the hotel tray's turning circle (`HOTEL_SWEEP_RADIUS`) plus where the marker-guided
   final approach may end (`WORKING_CLEARANCE`) does: that approach drives at the bearing to the
   working pose and turns to the bench there. With bench edges 0.32 to 0.34 m ahead, `Benchtop`, `Tuck`
-  and `NestApproach` stopped with head or arm joints off their goals (random layouts 80003, 80005,
-  80010, 80019 at 414b4a6, reproducible with `bench --replay`); in a direct reproduction the base
+  and `NestApproach` stopped with head or arm joints off their goals; in a direct reproduction the base
   link, which carries the tray, pressed into the bench with kilonewtons and shook torso and head;
 - turning room: the circle the onboard hotel tray sweeps when the base turns at a POI
   (`HOTEL_SWEEP_RADIUS` plus `TURN_MARGIN` for the navigation stop error) reaches a bench, its
@@ -47,17 +46,17 @@ TURN_MARGIN = 0.05
 ALIGN_SIGHTING_ERROR = 0.010
 """How much nearer the bench the working pose the marker shows from the POI may lie than the real one
 (m): the head camera's calibration (mount 1 mm and 0.1 deg per axis, head encoder zeros 0.1 deg, depth
-bias 1 mm at 1 m; one sigma each) over the 0.7 to 0.9 m to the marker, at three sigma. Random layout
-92012 measured 7.0 mm from draws of about two sigma."""
+bias 1 mm at 1 m; one sigma each) over the 0.7 to 0.9 m to the marker, at three sigma (draws of about
+two sigma were measured to give 7 mm)."""
 ALIGN_DRIVE_OVERSHOOT = 0.006
 """How far the final approach's drive passes its goal's line towards the bench (m): closing on a goal
 beside its heading, the drive curves in and crosses the line by up to 5.6 mm (0.21 m ahead, 0 to
-0.1 m aside; 5 mm at 92012) before it stops and turns."""
+0.1 m aside) before it stops and turns."""
 WORKING_CLEARANCE = HOTEL_SWEEP_RADIUS + ALIGN_SIGHTING_ERROR + ALIGN_DRIVE_OVERSHOOT
 """A working pose's least distance from every bench (m): the tray's turning circle, which the final
 approach sweeps in part (it drives at the bearing to the working pose, then turns to the bench), plus
-where that approach may end. At 0.361 m, with the circle taken as 0.35 and no margin, the tray touched
-the bench (random layout 92012: the base 12 mm nearer than its working pose, turned 28 deg)."""
+where that approach may end: with the circle taken as 0.35 m and no margin, a working pose 0.361 m
+from its bench let the tray touch it (the base ended 12 mm nearer than its working pose)."""
 REACH_ARM = "right"
 LOOK_TORSO_LIFT = 0.15
 """The torso height of "Home", where the first look at a station's marker is taken (m)."""
@@ -137,7 +136,8 @@ def _footprint_problems(world) -> Iterator[ServiceProblem]:  # noqa: ANN001
 def _undock_problems(world, dock_poi) -> Iterator[str]:  # noqa: ANN001
     """The undock drives straight from the docked pose to the dock's POI without turning: the base's
     footprint (the tray lies within it across) plus the navigation error must keep off every bench
-    along it. Random layout 75051 at efb7303 passed a bench 0.265 m from that line and grazed it."""
+    along it: a bench one base radius from that line is grazed although the docked pose and the POI
+    are both clear of it."""
     xs, ys = drive_points(world.dock_pose, dock_poi, 20)
     need = BASE_RADIUS + TURN_MARGIN
     for station in world.stations:

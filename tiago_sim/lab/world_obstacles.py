@@ -17,7 +17,7 @@ and its folded arms sweep 0.48 m from the base centre (navigation.planner.ARM_SW
 the hotel tray 0.354 m); the planner keeps 5 cm more (INFLATION_RADIUS_M, 0.53 m), and the robot
 may stop up to 9 cm off a POI along either axis (the navigation error: 3 cm per axis, 3 sigma, the
 campaign's default). At 0.55 m, a fridge 0.47 m from where a drive ended was either grazed by an
-arm or left no path (campaign seeds 98045, 98198)."""
+arm or left no path (docs/explanation/decisions/room-around-the-robot.md)."""
 DOCK_PATH_SAMPLES = 5
 
 
@@ -147,8 +147,8 @@ def bench_overlap_problems(benches: Iterable[Bench]) -> list[tuple[int, str]]:
 
     Why: two benches cannot stand in the same place, and a generated layout did draw them so: the
     higher bench's top then covered the other's nest, a finger touched it on the way into the nest
-    (random layout 91027: the storage bench over washer nest 1, 46 mm above its floor) and a plate
-    started inside it, unseen by its nest's sensor (91033). Benches that touch are apart.
+    (a bench top 46 mm above the nest's floor) and a plate started inside a bench, unseen by its
+    nest's sensor. Benches that touch are apart.
     """
     benches = list(benches)
     problems = []

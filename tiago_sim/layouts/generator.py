@@ -48,9 +48,9 @@ MARKER_IDS = tuple(i for i in range(MARKER_DICTIONARY_SIZE) if i not in MIRROR_A
 WALL_MARGIN = 0.3  # m between anything the robot uses and the floor's edge (walls 0.1 m thick)
 CORRIDOR = HOTEL_SWEEP_RADIUS + TURN_MARGIN
 # A navigation goal is a POI moved by the stop error (tiago_sim.measuring.disturbances: 30 mm per axis
-# and 2 deg, one sigma): random layout 83075 at 1c132be put a POI 0.48 m from the next bench, the
-# goal 36 mm off it was 0.45 m away and the planner found no straight way in along its heading. The
-# drawing plans to and from goals two sigma off (and 1.5 sigma turned) too.
+# and 2 deg, one sigma): with a POI 0.48 m from the next bench, a goal 36 mm off it was 0.45 m away
+# and the planner found no straight way in along its heading. The drawing plans to and from goals
+# two sigma off (and 1.5 sigma turned) too.
 STOP_ERROR_M = 0.06
 STOP_ERROR_RAD = math.radians(3.0)
 PLACEMENT_TRIES = 300  # per station, before the whole floor is drawn again
@@ -71,7 +71,7 @@ class _Box:
 
 def dock_box(world: World) -> _Box:
     """The dock's outline on the floor: a straight drive must keep off it as off a bench (a drive from
-    the dock's POI back past the dock ran the robot into it: layout seed 80006 at a22f3cf)."""
+    the dock's POI back past the dock ran the robot into it)."""
     pose = world.dock_pose
     x = pose.x - DOCK_BOX_BEHIND * math.cos(pose.yaw)
     y = pose.y - DOCK_BOX_BEHIND * math.sin(pose.yaw)
@@ -106,7 +106,7 @@ def route_problems(world: World) -> list[str]:
     """Why the robot could not drive this lab: two POIs with no planned path between them (`world
     check`'s rule), or a station's working pose it could not leave for the dock. The drawing keeps
     straight drives 0.40 m from the benches (the tray's turning circle), the planner wants 0.53 m
-    and the folded arms' band; random layout 91120 drew a lab whose dock no plan left."""
+    and the folded arms' band, so a drawn lab could have a dock that no plan leaves."""
     paths = plan_poi_paths(world)
     problems = paths.problems("layout")
     dock = world.pois[world.dock_poi]

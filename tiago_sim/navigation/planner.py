@@ -53,11 +53,11 @@ ARMS_LOWEST_M = 0.74
 ARMS_CLEAR_ABOVE_M = ARMS_LOWEST_M - 0.02
 """What stands no higher than this passes under the folded arms (a low bench: `build_map(above_m=)`);
 2 cm for the torso's and the arm joints' error (0.1 deg over the arm's 0.5 m is 1 mm). At 5 cm a
-0.712 m bench beside a working pose it had driven into kept the robot from leaving (layout 91121)."""
+0.712 m bench beside a working pose it had driven into kept the robot from leaving."""
 ARMS_HALF_WIDTH_M = ARM_SWEEP_RADIUS_M + FOOTPRINT_MARGIN_M
 """Half the width of the band the folded arms sweep on a straight segment: an obstacle beside the
 segment within this is touched by an arm even where the base passes it with room to spare (an arm
-grazed a fridge beside such a segment: campaign seed 98045)."""
+grazed a fridge beside such a segment)."""
 COMFORT_M = 0.15
 """Straight segments keep this much more than the inflation from obstacles where the room allows."""
 COST_RANGE_M = 0.40

@@ -7,8 +7,8 @@ millimetres at every station, mostly sideways), the arm's joint offsets shift th
 pick and a place those errors would cancel if the plate kept the offset it was grasped with, but it
 does not: the fingers centre its short side at the pick, and the onboard hotel's pocket (2 mm of
 clearance) re-centres it in the base frame, after which the hand holds it a few millimetres off in
-a way unrelated to the nest (replays of default-lab seed 60000: the nest believed 7 mm off, the
-plate released 9.4 mm off it, past the 7.5 mm its ramps capture). Seen in the same image as the
+a way unrelated to the nest (in replays the nest was believed 7 mm off and the plate released
+9.4 mm off it, past the 7.5 mm its ramps capture). Seen in the same image as the
 marker - the head unmoved since the marker was sighted, so the camera's error is the same - plate
 and nest share the camera's error and their difference is free of it and of the arm's: what is
 left is the marker's and the nest's own mounting on the station, and the depth noise.
@@ -106,9 +106,9 @@ def _top_plane(
 ) -> Callable[[np.ndarray, np.ndarray], np.ndarray] | None:
     """The plate top's plane z(x, y) fitted to the pixels found near its height, or None when it is
     tilted past `MAX_TILT_RAD`. The plate hangs tilted by a degree or more in the hand (it turns about
-    the fingers' axis while carried: 1.75 deg measured in random layout 75185, 4 deg in a failed run);
+    the fingers' axis while carried: 1.75 deg measured in one replay, 4 deg in a failed run);
     a level band about the median then cut off both ends, the plate measured 114 mm long and was put
-    down unmeasured, 5 mm off, onto a rim (random layouts 75083, 75185 at efb7303)."""
+    down unmeasured, 5 mm off, onto a rim."""
     inliers = np.ones(len(searched), dtype=bool)
     coefficients = np.zeros(3)
     for _ in range(3):  # least squares, then again on the pixels within the band of the last plane
@@ -238,8 +238,8 @@ def _extents(on_top: np.ndarray, inner: np.ndarray, tool_x: float, pad_width: fl
     x_low, x_high = _extent(along[:, 0])
     # The pads stand off the arm's tool position (joint readings) by the camera's calibration error
     # against the arm's, and off the plate's centre by where the hand holds it: either can be several
-    # millimetres (random layout 99012: the pads seen 7 mm off the tool, their outer faces taken for
-    # the plate's edges, 95 mm wide). The pads lie within both spans, so both are left out.
+    # millimetres (pads seen 7 mm off the tool had their outer faces taken for the plate's edges,
+    # 95 mm apart). The pads lie within both spans, so both are left out.
     pads_low = min(tool_x, (x_low + x_high) / 2) - pad_width / 2 - BEYOND_PADS_M
     pads_high = max(tool_x, (x_low + x_high) / 2) + pad_width / 2 + BEYOND_PADS_M
     beyond_pads = (on_top[:, 0] < pads_low) | (on_top[:, 0] > pads_high)

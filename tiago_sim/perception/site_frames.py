@@ -79,8 +79,8 @@ def upright_marker(T_base_marker: np.ndarray, T_table_marker: np.ndarray) -> np.
     0.15 m from its marker, so the marker's orientation error moves the nest by that lever. Position
     is what a single marker measures best; its out-of-plane tilt and its in-plane turn are what it
     measures worst, and the in-plane turn is partly a marker glued askew, which the nests do not
-    share. Seen tilted by 1.1 deg, the marker put a nest 7.5 mm too low (random layout 91028: a finger
-    pad pressed on the bench top); upright, 1.9 mm.
+    share. Seen tilted by 1.1 deg, the marker put a nest 7.5 mm too low (a finger pad pressed on the
+    bench top); upright, 1.9 mm.
     """
     T_base_table = levelled(np.asarray(T_base_marker, dtype=float) @ np.linalg.inv(T_table_marker))
     upright = np.asarray(T_base_marker, dtype=float).copy()
@@ -94,9 +94,9 @@ def at_height(T_base_frame: np.ndarray, height_m: float) -> np.ndarray:
     Why: a nest's height is the bench's, which the world file gives and no bench shift changes, while
     the height a marker sighting gives carries the head camera's calibration (its tilt over the 0.6 to
     0.9 m to the marker) and the marker's own mounting on its stand. Both reach several millimetres:
-    in default-lab seed 96195 the marker was seen 3.6 mm high and glued 2.7 mm up its stand, the nest
-    believed 6.3 mm high, and the finger pads closed over the plate's top ("nothing between the
-    fingers"). Position along the floor still comes from the marker: benches move on the floor.
+    a marker seen 3.6 mm high and glued 2.7 mm up its stand had the nest believed 6.3 mm high, and the
+    finger pads closed over the plate's top ("nothing between the fingers"). Position along the floor
+    still comes from the marker: benches move on the floor.
     """
     moved = np.asarray(T_base_frame, dtype=float).copy()
     moved[2, 3] = float(height_m)

@@ -39,8 +39,8 @@ points hold touching pairs only, so near misses come from closest-point queries,
 NEAR_MISS_PERIOD_S of sim time (the arm moves at most 1.5 cm in it near a bench), only for things
 within REACH_M. A measuring tool, off unless asked for (``near_misses=True``; the sim node's
 ``--near-misses``): it costs CPU on every review, and whether Bullet's closest-point queries
-leave its contact state untouched was not proven (default-lab seed 111 failed its placement in
-3 of 10 runs with them on, 1 of 10 with them off, 0 of 6 on main before navigation)."""
+leave its contact state untouched was not proven (a trial's placement failed more often with them
+on than off)."""
 NEAR_MISS_PERIOD_S = 0.02
 REACH_M = 1.2
 """Only things whose box lies within this of the base centre are queried for near misses (the arm

@@ -20,7 +20,7 @@ plate's motion and contacts, and checked against what Coulomb friction at the tw
   than it would have. That limit (1.28 N m at 16 N) is generous: uniform pressure on a strip as
   long as the pad is wide (80 mm) gives a mean lever arm of L / 4 = 20 mm, 0.64 N m at mu 1; with
   that value 6 of 30 scripted placements into the hotel pocket under the default calibration errors
-  let go of the plate as a corner met a lead-in (seeds 40020 to 40049), against none at 0.04 m.
+  let go of the plate as a corner met a lead-in, against none at 0.04 m.
   The twist the grip must hold is the moment of the loads above about the grasping frame (the
   plate's rotational inertia, 7e-4 kg m^2, is left out: at the arm's angular accelerations it is
   under 1 % of the capacity).
@@ -29,7 +29,7 @@ On the step where the physics step changes length (simulation.py's regimes) the 
 left out: PyBullet's position control corrects a joint's tracking error by a fraction per step, so
 a shorter step corrects it faster and the arm's (and the held plate's) velocity jumps within one
 short step. That jump is the simulator's discretisation, not a load: it let go of a deep-well plate
-as it neared the hotel pocket (seed 87026: 28.5 N against the 28.0 N friction holds, at the first
+as it neared the hotel pocket (28.5 N against the 28.0 N the friction holds, at the first
 1/240 s step after 1/60 s steps, nothing but the fingers touching it), and the plate, loose in the
 pocket, was later placed beside the nest. Weight and contacts still count on that step.
 

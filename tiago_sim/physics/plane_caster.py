@@ -4,8 +4,8 @@ Why: the base laser's rays run level at 0.0945 m, where a lab is upright boxes (
 the floor, walls, the dock, box obstacles, blockers) and upright cylinders (round obstacles). Cut
 by the laser's plane these are rectangles and circles, and a scan of 661 beams against them is a
 few array operations: 0.5 to 0.6 ms of CPU in a transfer's scans against 3.3 to 3.8 ms for
-PyBullet's rayTestBatch, which walks its broadphase tree once per ray (random layouts, seeds 40000
-and 40001; some 200 scans a transfer).
+PyBullet's rayTestBatch, which walks its broadphase tree once per ray (random layouts, some 200
+scans a transfer).
 
 The cross-sections are read from PyBullet's collision shapes and poses at every cast, so a body
 added, moved or removed (a blocker, a fault) is seen at once. Anything else that reaches the plane

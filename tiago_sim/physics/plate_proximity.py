@@ -19,7 +19,7 @@ STEP_REVIEW_PERIOD = 0.05  # s of sim time between proximity checks (tool <= 1.5
 # faster one travels in a review period at its current speed (it cannot get there unnoticed): a
 # robot link and a plate no gripper holds (the link's point nearest the plate, the plate resting),
 # or a held plate and anything but its own arm. Before, a robot link within a fixed 0.15 m of a
-# resting plate kept the steps short: 1695 of a transfer's 2900 short steps (seed 40001), most of
+# resting plate kept the steps short: 1695 of a transfer's 2900 short steps, most of
 # them with the tool still 4 to 15 cm away at its 0.08 m/s.
 CONTACT_MARGIN = 0.03  # m
 MAX_LINK_SPEED = 1.5  # m/s: no robot link moves faster (arm joint limits); bounds the query radius

@@ -27,7 +27,7 @@ from tiago_sim.physics.seating import PoseInNest, SeatingLimits
 NEST_SENSOR_RANGE = 0.02  # m: presence sensor sees a plate whose centre is this close to the site
 # m: and whose bottom is at most this far above the pocket floor. A nest's sensor is a short-range
 # proximity sensor in the pocket floor: a plate resting on a lead-in's rim (3 mm up at its centre,
-# the one failure mode of the 200 trials at 7b59091) is not seen, so the robot reports it as not
+# a failure mode campaigns have shown) is not seen, so the robot reports it as not
 # placed instead of delivered. A seated plate lies within the success check's 1 mm.
 NEST_SENSOR_GAP = 0.0015
 HOTEL_SENSOR_GAP = 0.01  # m: the hotel pockets' sensors see a plate anywhere on their ramps; and

@@ -62,7 +62,7 @@ SOLVER_ITERATIONS = 20
 # the curved path); the hotel clamp now holds it while the base moves.
 FREE_MOTION_STEP_RATIO = 4
 # Only the base driving (no other motion, no plate in reach): twice as long, half of a transfer's
-# simulated time (seed 40001: 2.22 instead of 2.71 s CPU in motion). Not for arm motions: at 1/30 s
+# simulated time (the sim thread's CPU in motion fell by a fifth). Not for arm motions: at 1/30 s
 # the wrists missed SETTLE_TOLERANCE by 3 to 11 mrad (7 of 8 transfers failed).
 DRIVE_STEP_RATIO = 8
 # Error reduction of joint constraints (the base carrier) per step: Bullet's 0.2 at 1/240 s, 0.5 at

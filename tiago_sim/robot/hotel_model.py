@@ -20,7 +20,7 @@ TRAY_BEYOND_POCKET = (0.03, 0.02)  # m: the tray plate is the pocket plus this a
 # rim's height too), as the station nests' brackets. The pockets had a 4 mm vertical wall under 6 mm
 # chamfers until the default calibration errors (joint offsets, about 1.3 mm median at the hotel) put
 # plates at the pocket edge: a plate's end then came to rest on the wall's top corner, 2 deg tilted
-# (3 of 6 scripted placements, seeds 40010 to 40049), the failure mode the nests had with a 1.5 mm wall.
+# (3 of 6 scripted placements), the failure mode the nests had with a 1.5 mm wall.
 HOTEL_LEAD_IN = 0.008
 RAMP_FOOT = 0.001  # a ramp runs on this far below the floor it rises from: no edge is left at its foot
 RAMP_LEG_LENGTH = 0.015  # bracket legs run this far in from each corner

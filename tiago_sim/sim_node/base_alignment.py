@@ -3,11 +3,10 @@
 Why: navigation ends a few centimetres and degrees off its goal (localisation error), and the
 onboard hotel tray reaches 0.33 m ahead of the base centre. Standing at the working distance
 straight from navigation, a 3 to 9 cm error made the turning base sweep the tray into the table
-and knock the plate out of its pocket (seeds 100 and 105 of the default campaign), or left the
-arm no room to unfold (seed 102). So navigation stops farther back (the station's ``standoff``,
-0.22 m behind the working pose: navigation error and odometry drift together reached 18 cm at
-seed 2041); then the robot looks at the station's marker, works out where the working pose
-(``work_standoff``) really is, and drives the last ~22 cm there. The torso rises to the bench
+and knock the plate out of its pocket, or left the arm no room to unfold. So navigation stops farther
+back (the station's ``standoff``, 0.22 m behind the working pose: navigation error and odometry drift
+together have reached 18 cm); then the robot looks at the station's marker, works out where the working
+pose (``work_standoff``) really is, and drives the last ~22 cm there. The torso rises to the bench
 working height and the head turns to the bench during that drive (independent joints overlap).
 
 Only robot knowledge is used: the head camera image and depth, joint readings, odometry, the
@@ -48,8 +47,8 @@ def planar(transform: np.ndarray) -> tuple[float, float, float]:
 
 def _search(run: ActionRun, kinematics: RobotKinematics, target: np.ndarray, look: Any, lifting: Any) -> Any:
     """Point the head where the marker should be and look; if it is not in the image, pan left and
-    right and look again (odometry drifts over a long drive: seed 316 arrived 18 cm and 5 deg off
-    its belief). Every extra look is logged; MARKER_NOT_FOUND only when all of them fail.
+    right and look again (odometry drifts over a long drive: a robot has arrived 18 cm and 5 deg
+    off its belief). Every extra look is logged; MARKER_NOT_FOUND only when all of them fail.
 
     The first look happens while the torso still rises to the bench height; a torso left low by
     an earlier motion rises for seconds and carried the marker out of the image's bottom edge. So
@@ -83,10 +82,9 @@ def working_pose(station: Station, sub_position: int, arm: str) -> np.ndarray:
 
     Why: a row may span the whole band, its end nests on the band's edges, and the calibration
     errors then put one a centimetre beyond: the arm could not reach a nest 0.7 to 1.6 cm left of
-    the centre line, 0.78 to 0.84 m high (IK_FAILED: random layouts 98147, 101047, 101069, 101115),
-    and at the far end, 0.45 m right, the fingers closed on a plate pressed into its nest by 45 to
-    82 N and the grip let go of it (PLATE_SLIPPED: 102011, 102031). All six failed the same way
-    before this session's changes."""
+    the centre line, 0.78 to 0.84 m high (IK_FAILED), and at the far end, 0.45 m right, the fingers
+    closed on a plate pressed into its nest by 45 to 82 N and the grip let go of it (PLATE_SLIPPED)
+    (docs/explanation/decisions/working-pose-inside-the-arm-band.md)."""
     T_world_work = station.aligned_pose().matrix()
     side = -1.0 if arm == "right" else 1.0  # the working arm's side of the base, along its y
     inward = side * float((tf.invert(T_world_work) @ station.T_world_site(sub_position))[1, 3])
@@ -151,8 +149,8 @@ def align_base(
                 run.run_motion(lambda _sim, motion=motion: motion, span=span)
         # From the working pose the marker is where the first sighting puts it; the head aims there
         # and searches as before. The bench posture's fixed head angles see a marker beside the
-        # nests of the default lab only: a marker 0.37 m right of the base (random layout 93001)
-        # was out of the image, MARKER_NOT_FOUND with nothing disturbed.
+        # nests of the default lab only: a marker 0.37 m right of the base was out of the image,
+        # MARKER_NOT_FOUND with nothing disturbed.
         T_marker_at_work = tf.invert(tf.from_planar(*correction)) @ sighting.T_base_marker
         # from the working pose: later tool moves reuse this sighting while the base stands
         return _search(run, kinematics, T_marker_at_work[:3, 3], look, None)

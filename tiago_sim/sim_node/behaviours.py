@@ -151,8 +151,8 @@ class RobotBehaviours:
         # Every fixed motion leaves the hotel straight up to the carry height first: a held plate is
         # never swept through the hotel, and an empty gripper folding from the hotel's approach pose
         # (0.71 m high) swings its pads up to 0.40 m ahead of the base at 0.77 m, where a bench's front
-        # edge (0.36 .. 0.45 m ahead at a working pose, top up to 0.78 m) stands: random layout 91089,
-        # Tuck after GetLabware grazed the incubator's edge 1.5 mm deep. From the carry height the fold
+        # edge (0.36 .. 0.45 m ahead at a working pose, top up to 0.78 m) stands: Tuck after
+        # GetLabware has grazed such an edge 1.5 mm deep. From the carry height the fold
         # stays above 0.85 m (tests/tiago_sim/robot/test_fold_sweep.py).
         first = self.leave_hotel(run, arm)
         speed = self.speed_scale() * self.motions.speed_scale
@@ -266,7 +266,7 @@ class RobotBehaviours:
 
         The arm alone first (the torso lifts at only 0.07 m/s and would set the pace), the torso too
         only if the arm alone cannot reach; 60 seeded IK restarts rather than the simulator's 30
-        (seed 111: those found no solution for the hotel from the tucked arm).
+        (30 have found no solution for the hotel from the tucked arm).
         """
         log.info("no straight path to %s: moving in joint space", np.round(T_base_grasp[:3, 3], 3))
         seed = run.sim(lambda sim: dict(sim.joint_positions()))

@@ -149,7 +149,7 @@ class MarkerMotionBehaviour:
         """Whether a move to the site's approach pose may go in joint space where no straight line has
         IK: from anywhere but straight below it (a tool in the nest, or just out of it, must rise
         straight). From the arm-to-bench pose to the far nest of a 4-nest row the line left the arm's
-        reach at waypoint 12 of 34 (random layout 75164 at efb7303); the contact watch still stops a
+        reach at waypoint 12 of 34, though the nest itself is reachable; the contact watch still stops a
         joint-space move that touches anything."""
         joints = run.sim(lambda sim: dict(sim.joint_positions()))
         tool = self.behaviours.tool_pose(arm, joints)[:3, 3]
@@ -194,8 +194,8 @@ class MarkerMotionBehaviour:
         seed = run.sim(lambda sim: dict(sim.joint_positions()))
         # Nests sit on level benches and the base stands on the floor, so the nest frame is levelled:
         # a marker glued 1.4 deg askew in its plane tilted the perceived nest by as much, and together
-        # with the height it shifts put a finger tip into the bench (seed 4029, "nothing between the
-        # fingers"). Heading and position still come from the marker.
+        # with the height it shifts put a finger tip into the bench ("nothing between the fingers").
+        # Heading and position still come from the marker.
         # The marker's tilt comes from the level bench, not the image (perception.site_frames.upright_marker).
         # The height is the bench's (world file), not the sighting's (perception.site_frames.at_height).
         height = float((station.T_world_marker() @ T_marker_site)[2, 3])

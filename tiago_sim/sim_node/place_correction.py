@@ -3,12 +3,12 @@ the tool (a move and a turn) that puts it on the nest (robot software).
 
 Why: the tool reaches the nest the marker shows, but the plate hangs in the hand where the hotel's
 pocket and the fingers left it, and the head camera's calibration error moves the nest the robot
-sees; together they put plates 8 to 11 mm off the nest, past the 7.5 mm its ramps capture (default
-lab, seeds 60000, 60034, 60077). The camera sees plate and marker with the same error while the head
-stands where it stood when it saw the marker, so the plate's offset from the nest it measures holds
-neither that error nor the arm's (``tiago_sim.perception.held_plate``). The shift is then the planar
-move of the tool that brings the plate's centre over the nest's and its long side along the nest's:
-from the tool's pose (joint readings) and the plate's (camera), both in the site frame the marker
+sees; together they put plates 8 to 11 mm off the nest, past the 7.5 mm its ramps capture
+(docs/explanation/decisions/measure-the-held-plate.md). The camera sees plate and marker with the same
+error while the head stands where it stood when it saw the marker, so the plate's offset from the nest
+it measures holds neither that error nor the arm's (``tiago_sim.perception.held_plate``). The shift is
+then the planar move of the tool that brings the plate's centre over the nest's and its long side along
+the nest's: from the tool's pose (joint readings) and the plate's (camera), both in the site frame the marker
 gave. The turn is part of it since a plate turned 0.7 deg and 1.5 mm across left a corner on a
 lead-in (default lab, a CI run of test_examples).
 
@@ -37,7 +37,7 @@ HEAD_JOINTS = ("head_1_joint", "head_2_joint")
 # same in both images. That error (mount offset, encoder zeros) is constant; turning the head by
 # 0.01 rad turns the few millimetres it makes at the nest by as much, a change of hundredths of a
 # millimetre. A head still settling from its last aim moved 1 to 3 mrad between the two images,
-# and 0.5 mrad skipped the measurement then (default-lab seeds 96000, 96015 at 591b7bc).
+# and a limit of 0.5 mrad skipped the measurement then.
 SAME_HEAD_RAD = 0.01
 # A larger shift is not believed: the measurement would have gone wrong (the nest's ramps capture
 # 7.5 mm, calibration and mounting errors reach about 12 mm together at three sigma).
