@@ -37,7 +37,7 @@ from collections.abc import Mapping, Sequence
 
 logger = logging.getLogger(__name__)
 
-PRELOADED_MODULES = ("tiago_sim.sim_node.node", "tiago_sim.physics.simulation", "tiago_sim.sequencer.node")
+PRELOADED_MODULES = ("tiago_sim.sim_node.node", "tiago_sim.physics.simulation", "tiago_sim.sequencer.startup")
 """What the fork server imports once: the robot side's nodes and their heavy dependencies."""
 PR_SET_CHILD_SUBREAPER = 36
 PR_SET_NAME = 15

@@ -16,13 +16,14 @@ import time
 from pathlib import Path
 from typing import Any
 
-from labware_interfaces.msg import LabwareInventory, LabwareRecord
+from labware_interfaces.msg import ErrorCodes, LabwareInventory, LabwareRecord
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 from labware_model.holders import GRIPPER, HotelSlot, Location, Nest, location_text
-from labware_model.inventory import LabwareBook, SensedPlate, sensed_plates
+from labware_model.inventory import LabwareBook, NameTaken, SensedPlate, sensed_plates
 from labware_model.readings import HotelSlotReading, NestReading
+from tiago_sim.sequencer.plans import TaskRefused
 
 log = logging.getLogger("tiago_sim.sequencer.inventory")
 
@@ -117,11 +118,23 @@ class InventoryKeeper:
         except OSError as error:
             log.error("inventory file %s not written: %s", self.path, error)
 
-    def name_plate(self, holder: Location, name: str, labware_type: str, label: str) -> str:
-        """Name the plate at `holder` for a goal (LabwareBook.name_plate); returns the name ("" for
-        an unread plate nobody named). Raises NameTaken."""
+    def name_for_goal(self, request: Any, source: Location, label: str, label_checks: bool) -> str:
+        """Name the goal's plate before anything moves (LabwareBook.name_plate): the goal's id, else
+        the name the plate at `source` has, else its label; returns it ("" for an unread plate
+        nobody named). A label that reads other than the goal's id is noted, and refused
+        (TaskRefused LABEL_MISMATCH) only with `label_checks` on; a name another plate has at
+        another place is refused (LABWARE_ELSEWHERE)."""
+        name = request.labware_id
+        if name and label and name != label and label_checks:
+            raise TaskRefused(
+                ErrorCodes.LABEL_MISMATCH,
+                f"label checks are on: the plate at {source} reads {label!r}, not {name!r}",
+            )
         before = self.book.records()
-        record = self.book.name_plate(holder, name, labware_type, label)
+        try:
+            record = self.book.name_plate(source, name, request.labware_type, label)
+        except NameTaken as taken:
+            raise TaskRefused(ErrorCodes.LABWARE_ELSEWHERE, str(taken)) from taken
         if self.book.records() != before:
             self.changed()
         return record.labware_id if record is not None else ""

@@ -1,6 +1,7 @@
 """Task sequencer: GetLabware and PutLabware as sequences of the robot's own actions.
 
     python -m tiago_sim.sequencer [--world FILE] [--params tiago_sim/sequencer/sequencer.yaml]
+                                  [--inventory FILE] [--label-checks]     (see startup.py)
 
 A separate node and only a client of the robot-level actions (/navigate_to_poi, /undock,
 /play_motion, /marker_motion, /gripper) and of /describe_workcell, /robot_state and
@@ -27,13 +28,11 @@ each, then the goal aborts with INTERNAL saying so.
 
 from __future__ import annotations
 
-import argparse
 import logging
 import time
 from pathlib import Path
 from typing import Any
 
-import yaml
 from action_msgs.msg import GoalStatus
 from labware_interfaces.action import (
     GetLabware,
@@ -47,15 +46,12 @@ from labware_interfaces.action import (
 from labware_interfaces.msg import ErrorCodes, RobotState, StationStates
 from labware_interfaces.srv import DescribeWorkcell
 from rclpy.action import ActionClient, ActionServer, CancelResponse, GoalResponse
-from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.task import Future
 
 from labware_model.holders import GRIPPER
-from labware_model.inventory import NameTaken
 from labware_model.workcell import WorkcellDescription
-from tiago_sim.node_main import spin_node
 from tiago_sim.sequencer.inventory_keeper import InventoryKeeper
 from tiago_sim.sequencer.plans import (
     RETREAT_AFTER,
@@ -75,7 +71,6 @@ from tiago_sim.sequencer.waits import describe_workcell, sleep, wait_answering, 
 
 log = logging.getLogger("tiago_sim.sequencer")
 
-DEFAULT_PARAMS = Path(__file__).with_name("sequencer.yaml")
 SUB_ACTIONS = {
     "undock": (Undock, "/undock"),
     "navigate": (NavigateToPoi, "/navigate_to_poi"),
@@ -231,7 +226,8 @@ class Sequencer:
             try:
                 plan = await self._plan(request, make_plan, arrived=time.monotonic())
                 label = label_at_source(request, self.robot_state, self.station_states, kind is PutLabware)
-                result.labware_id = self._name_plate(request, source, label)
+                checks = bool(self.param("label_checks"))
+                result.labware_id = self.inventory.name_for_goal(request, source, label, checks)
             except (TaskRefused, StepFailed) as refusal:
                 return self._finish(goal_handle, result, refusal.code, refusal.message)
             destination = source_of(request, kind is GetLabware)
@@ -275,21 +271,6 @@ class Sequencer:
                 self.active = None
 
         return execute
-
-    def _name_plate(self, request: Any, source: Any, label: str) -> str:
-        """Name the goal's plate before anything moves (labware_model.inventory): the goal's id,
-        else the name the inventory has for the plate at the source, else its label. A label that
-        reads other than the goal's id is noted, and refused only with `label_checks` on."""
-        name = request.labware_id
-        if name and label and name != label and bool(self.param("label_checks")):
-            raise TaskRefused(
-                ErrorCodes.LABEL_MISMATCH,
-                f"label checks are on: the plate at {source} reads {label!r}, not {name!r}",
-            )
-        try:
-            return self.inventory.name_plate(source, name, request.labware_type, label)
-        except NameTaken as taken:
-            raise TaskRefused(ErrorCodes.LABWARE_ELSEWHERE, str(taken)) from taken
 
     async def _retreat(self, run: TaskRun, plan: list[Step]) -> None:
         """Best effort after the gripper was left empty: bring the arm out of the nest or pocket and
@@ -404,44 +385,3 @@ class Sequencer:
             goal_handle.abort()
         log.info("task ended: %s %s", code or "OK", message)
         return result
-
-
-def load_params(path: Path) -> dict[str, Any]:
-    params = yaml.safe_load(Path(path).read_text())
-    missing = {*PARAMETERS, "estimates_s"} - set(params)
-    if missing:
-        raise ValueError(f"{path}: missing {', '.join(sorted(missing))}")
-    return params
-
-
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m tiago_sim.sequencer", description=__doc__.split("\n")[0])
-    parser.add_argument(
-        "--world", type=Path, default=None, help="accepted for symmetry; the robot describes the cell"
-    )
-    parser.add_argument(
-        "--params", type=Path, default=DEFAULT_PARAMS, help="parameter YAML (default: %(default)s)"
-    )
-    parser.add_argument(
-        "--inventory",
-        type=Path,
-        default=None,
-        help="file that keeps the labware inventory across restarts (default: kept in memory only)",
-    )
-    parser.add_argument(
-        "--label-checks",
-        action="store_true",
-        help="refuse a transfer whose plate's label reads other than the goal's labware id",
-    )
-    parser.add_argument("--log-level", default="INFO")
-    args = parser.parse_args(argv)
-    logging.basicConfig(level=args.log_level, format="%(asctime)s %(levelname)s %(name)s: %(message)s")
-    params = load_params(args.params)
-    params["label_checks"] = bool(params["label_checks"]) or args.label_checks
-
-    def build(node: Node) -> Sequencer:
-        sequencer = Sequencer(node, params, args.inventory)
-        log.info("sequencer ready")
-        return sequencer
-
-    return spin_node("labware_sequencer", SingleThreadedExecutor, build)

@@ -111,6 +111,18 @@ class Scheduler:
         )
         await self.together(run(site.LabwareDelivered, HandoverPosition=handover(destination)))
 
+    async def refused_to_prepare(self, source: tuple[str, int], labware_id: str, says: str) -> None:
+        """PrepareForInput at `source` naming `labware_id` must be refused as out of sequence."""
+        with pytest.raises(DefinedExecutionError, match=says) as refused:
+            await run(
+                self.robot.PrepareForInput,
+                HandoverPosition=handover(source),
+                InternalPosition=1,
+                LabwareType="",
+                LabwareUniqueID=labware_id,
+            )
+        assert refused.value.identifier == "InvalidCommandSequence"
+
     async def where(self, labware_id: str) -> tuple[bool, str, int]:
         location = (await self.inventory.LocateLabware(LabwareUniqueID=labware_id)).Location
         return location.Aboard, location.Position, location.Index
@@ -145,24 +157,9 @@ async def scheduler_run(stack: Deployment) -> list[str]:
         await scheduler.get(B1, 1, FIRST)
         await scheduler.get(A2, 2, SECOND)
         assert await scheduler.where(SECOND) == (True, "", 2)
-        with pytest.raises(DefinedExecutionError, match="'p1' is already aboard") as refused:
-            await run(
-                scheduler.robot.PrepareForInput,
-                HandoverPosition=handover(A1),
-                InternalPosition=1,
-                LabwareType="",
-                LabwareUniqueID=FIRST,
-            )
-        assert refused.value.identifier == "InvalidCommandSequence"
+        await scheduler.refused_to_prepare(A1, FIRST, "'p1' is already aboard")
         await scheduler.put(1, A1, FIRST)
-        with pytest.raises(DefinedExecutionError, match="'p1' is at station_a/1, not at station_b/1"):
-            await run(
-                scheduler.robot.PrepareForInput,
-                HandoverPosition=handover(B1),
-                InternalPosition=1,
-                LabwareType="",
-                LabwareUniqueID=FIRST,
-            )
+        await scheduler.refused_to_prepare(B1, FIRST, "'p1' is at station_a/1, not at station_b/1")
         await scheduler.put(2, B2, SECOND)
         assert await scheduler.where(FIRST) == (False, *A1)
         assert await scheduler.where(SECOND) == (False, *B2)

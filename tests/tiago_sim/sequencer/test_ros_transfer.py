@@ -209,6 +209,31 @@ def test_unknown_station_and_empty_slot_are_refused(robot: RosCaller) -> None:
     assert outcome.result.error_code == ErrorCodes.SLOT_EMPTY
 
 
+def set_label_checks(robot: RosCaller, on: bool) -> None:
+    value = ParameterValue(type=ParameterType.PARAMETER_BOOL, bool_value=on)
+    request = SetParameters.Request(parameters=[Parameter(name="label_checks", value=value)])
+    response = robot.call_service(SetParameters, "/labware_sequencer/set_parameters", request)
+    assert response.results[0].successful, response.results[0].reason
+
+
+def test_with_label_checks_on_an_id_the_label_does_not_read_is_refused_before_the_arm_moves(
+    robot: RosCaller,
+) -> None:
+    before = arm_joints(robot)
+    goal = task_goal(GetLabware, "station_a", 1, 1)
+    goal.labware_id = "scheduler-name"  # the plate's label reads plate_001
+    set_label_checks(robot, True)
+    try:
+        outcome = robot.call_action(GetLabware, "/get_labware", goal, timeout_s=30.0)
+    finally:
+        set_label_checks(robot, False)
+    assert outcome.status == GoalStatus.STATUS_ABORTED
+    assert outcome.result.error_code == ErrorCodes.LABEL_MISMATCH, outcome.result.message
+    assert "reads 'plate_001', not 'scheduler-name'" in outcome.result.message
+    after = arm_joints(robot)
+    assert max(abs(after[n] - before[n]) for n in before) < 0.01, "the arm moved"
+
+
 def test_occluded_marker_aborts_without_touching_the_plate(robot: RosCaller) -> None:
     set_parameter(robot, "fault.occlude_marker", "station_a")
     try:

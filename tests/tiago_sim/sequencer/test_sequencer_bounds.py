@@ -20,7 +20,7 @@ from labware_interfaces.action import GetLabware
 from labware_interfaces.msg import ErrorCodes
 
 from tests.helpers.ros_processes import RosCaller, running
-from tiago_sim.sequencer.node import DEFAULT_PARAMS
+from tiago_sim.sequencer.startup import DEFAULT_PARAMS
 
 
 @dataclass

@@ -7,8 +7,8 @@ from pathlib import Path
 import pytest
 
 from tests.tiago_sim.sequencer.test_plans import WORKCELL, goal, robot, stations
-from tiago_sim.sequencer.node import load_params
 from tiago_sim.sequencer.plans import Step, get_plan, put_plan
+from tiago_sim.sequencer.startup import load_params
 from tiago_sim.sequencer.step_durations import FALLBACK_S, StepDurations, step_kind, table_from_parameters
 
 SEQUENCER_YAML = Path(__file__).resolve().parents[3] / "tiago_sim" / "sequencer" / "sequencer.yaml"
