@@ -317,9 +317,12 @@ def bluesky_demo(args: argparse.Namespace) -> int:
     with ProcessGroup(ros_environment(domain_id), args.log_dir) as children:
         start_robot_side(children, args.world)
         sys.stderr.write(f"robot side started (ROS domain {domain_id}); running the Bluesky plan\n")
-        return run_bluesky_demo(
+        exit_code = run_bluesky_demo(
             args.world, domain_id=domain_id, ready_timeout_s=args.ready_timeout, progress_bar=True
         )
+    outcome = "the plate is back in its starting nest" if exit_code == 0 else "FAILED (the reason is above)"
+    sys.stderr.write(f"bluesky demo: {outcome}\n")
+    return exit_code
 
 
 def _bench(args: argparse.Namespace) -> int:

@@ -1,5 +1,6 @@
 """The `sila-labware` command: usage errors, `serve` and `demo` under signals, `demo --json`, and
-what a run leaves in the temp folder (nothing)."""
+what a run leaves in the temp folder (nothing). Through the installed entry point (the console
+script a user types), and the Ctrl-C test through `./run demo`."""
 
 from __future__ import annotations
 
@@ -19,9 +20,10 @@ import numpy as np
 import pytest
 from sila2.client import SilaClient
 
+from tests.helpers.run_script import RUN, assert_set_up
 from tests.helpers.sila_stack import free_port_base
 
-CLI = [sys.executable, "-m", "sila_labware.cli"]
+CLI = [str(Path(sys.executable).with_name("sila-labware"))]
 
 
 def run_cli(
@@ -158,6 +160,7 @@ def test_demo_json_reports_the_transfer_and_records_pictures(tmp_path: Path) -> 
     assert len(report["steps"]) == 6
     assert all(set(step) == {"name", "sim_seconds", "wall_seconds"} for step in report["steps"])
     assert report["success"] is True, report
+    assert (report["error"], report["error_kind"], report["exit_code"]) == ("", "", 0)
     assert done.returncode == 0, done.stderr[-2000:]
     assert "without encryption" in done.stderr.lower()
     assert_run_pictures(record_dir)
@@ -183,6 +186,7 @@ def test_demo_json_reports_a_start_up_failure_as_an_object_and_cleans_up(tmp_pat
     assert done.returncode == 1, done.stderr[-2000:]
     report = json.loads(done.stdout)
     assert report["success"] is False
+    assert (report["error_kind"], report["exit_code"]) == ("start_failed", 1)
     assert (
         report["error"].startswith("could not start: ")
         and f"127.0.0.1:{port_base} is already in use" in (report["error"])
@@ -196,8 +200,9 @@ def test_ctrl_c_stops_a_demo_mid_transfer_within_5_s_and_leaves_nothing_behind(t
     130, says so in its JSON object, and neither its robot side (own sessions, which a terminal's
     Ctrl-C never reaches) nor its temp directory survives it."""
     temp_dir = tmp_path / "tmp"
+    assert_set_up()  # `./run demo` then execs `sila-labware demo` at once: the signals reach it
     demo = subprocess.Popen(
-        [*CLI, "demo", "--json", "--no-discovery", "--port-base", str(free_port_base(4))],
+        [RUN, "demo", "--json", "--no-discovery", "--port-base", str(free_port_base(4))],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
@@ -232,6 +237,7 @@ def test_ctrl_c_stops_a_demo_mid_transfer_within_5_s_and_leaves_nothing_behind(t
     assert not [pid for pid in child_pids if _pid_alive(pid)], "the robot side outlived the demo"
     report = json.loads(stdout)
     assert report["success"] is False and report["error"].startswith("interrupted")
+    assert (report["error_kind"], report["exit_code"]) == ("interrupted", 130)
     assert "Traceback" not in "".join(rest), "".join(rest)[-3000:]
     assert left_in_temp(temp_dir) == [], "an interrupted demo leaves nothing in the temp folder"
 
