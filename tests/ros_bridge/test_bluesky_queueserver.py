@@ -76,11 +76,12 @@ def logs(tmp_path_factory: pytest.TempPathFactory) -> Path:
 @pytest.fixture(scope="module")
 def serve(logs: Path) -> Iterator[RobotLink]:
     """`sila-labware serve` in this run's ROS domain; a link to its robot side for the checks."""
+    errors = (logs / "serve.err").open("w")
     process = subprocess.Popen(
         [SILA_LABWARE, "serve", "--insecure", "--no-discovery", "--port-base", str(free_port_base(4))]
         + ["--log-dir", str(logs / "serve")],
         stdout=subprocess.PIPE,
-        stderr=open(logs / "serve.err", "w"),  # noqa: SIM115 - closed with the process
+        stderr=errors,
         text=True,
     )
     try:
@@ -91,7 +92,9 @@ def serve(logs: Path) -> Iterator[RobotLink]:
             link.wait_until_ready(timeout_s=60.0)
             yield link
     finally:
-        assert stop(process) == 0, (logs / "serve.err").read_text()[-2000:]
+        exit_code = stop(process)
+        errors.close()
+        assert exit_code == 0, (logs / "serve.err").read_text()[-2000:]
 
 
 @dataclass(frozen=True)
@@ -104,13 +107,15 @@ class QueueServer:
 
 @pytest.fixture(scope="module")
 def queue_server(serve: RobotLink, logs: Path) -> Iterator[QueueServer]:
-    control_port, info_port = free_port_base(1), free_port_base(1)
+    control_port = free_port_base(2)
+    info_port = control_port + 1
+    errors = (logs / "queueserver.err").open("w")
     process = subprocess.Popen(
         [sys.executable, "-m", "ros_bridge.bluesky.queueserver"]
         + ["--zmq-control-addr", f"tcp://127.0.0.1:{control_port}"]
         + ["--zmq-info-addr", f"tcp://127.0.0.1:{info_port}", "--log-dir", str(logs / "queueserver")],
         stdout=subprocess.PIPE,
-        stderr=open(logs / "queueserver.err", "w"),  # noqa: SIM115 - closed with the process
+        stderr=errors,
         text=True,
         cwd=REPOSITORY,
     )
@@ -124,6 +129,7 @@ def queue_server(serve: RobotLink, logs: Path) -> Iterator[QueueServer]:
         yield server
     finally:
         exit_code = stop(process, signal.SIGTERM)
+        errors.close()
         output = (logs / "queueserver.err").read_text()[-3000:]
         assert exit_code == 0, output
     # stopped in turn: the manager (its worker with it) and the Redis the launcher started
