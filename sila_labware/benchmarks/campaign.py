@@ -149,9 +149,8 @@ class CampaignOptions:
 
 def trial_stack(options: CampaignOptions, trial_seed: int, worker: int = 0) -> DeploymentOptions:
     """One trial's deployment: its world (random layout or the campaign's); the worker's own SiLA ports,
-    ROS domain (a requested id shifted by the worker index) and CA file (with a shared one a client
-    could read another worker's CA and refuse its own servers: CERTIFICATE_VERIFY_FAILED); a robot
-    side forked prewarmed."""
+    ROS domain (a requested id shifted by the worker index) and CA file (a shared one let a client
+    read another worker's CA and refuse its own servers); a robot side forked prewarmed."""
     extra = ["--disturbance-seed", str(trial_seed), "--disturbance-levels", levels_json(options.levels)]
     layouts, domain_id, ca = options.layouts_dir, options.stack.domain_id, options.stack.ca_file
     return replace(
