@@ -45,7 +45,11 @@ from sila_labware.benchmarks.campaign_cli import (
     write_recorded_pictures,
 )
 from sila_labware.deployment import json_outcome
-from sila_labware.deployment.cli_arguments import add_robot_side_arguments, add_stack_arguments
+from sila_labware.deployment.cli_arguments import (
+    add_inventory_arguments,
+    add_robot_side_arguments,
+    add_stack_arguments,
+)
 from sila_labware.deployment.connection_config import add_print_config_argument, print_servers, write_config
 from sila_labware.deployment.json_outcome import JsonOutput, UsageError, outcome_fields
 from sila_labware.deployment.pacing import add_pace_argument, pace_problem
@@ -83,6 +87,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     add_stack_arguments(serve, DEFAULT_WORLD)
     add_pace_argument(serve)
+    add_inventory_arguments(serve)
     add_print_config_argument(serve)
     demo = subcommands.add_parser(
         "demo", help="serve, then move the plate from the first station to the second"
@@ -168,6 +173,8 @@ def _deployment_options(args: argparse.Namespace, ca_file: Path) -> DeploymentOp
         extra_sim_arguments=[] if record is None else ["--record-dir", str(record / "frames")],
         lab_name=args.name,
         pace=getattr(args, "pace", None),
+        inventory_file=getattr(args, "inventory", None),
+        label_checks=getattr(args, "label_checks", False),
     )
 
 

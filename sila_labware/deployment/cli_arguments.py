@@ -60,3 +60,21 @@ def add_stack_arguments(sub: argparse.ArgumentParser, default_world: Path) -> No
         help="the lab's name, carried by every server name so that two labs on one network are told "
         "apart (default: the world file's `name`, else its file name)",
     )
+
+
+def add_inventory_arguments(sub: argparse.ArgumentParser) -> None:
+    """The robot side's labware inventory (labware_model.inventory): where it is kept, label checks."""
+    sub.add_argument(
+        "--inventory",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="keep the robot's labware inventory (the scheduler's names for its plates) in FILE, so that "
+        "it outlives this serve (default: a file of this run's own, kept across restarts of the robot side)",
+    )
+    sub.add_argument(
+        "--label-checks",
+        action="store_true",
+        help="refuse a transfer whose plate's label reads other than the scheduler's LabwareUniqueID "
+        "(default: transfer it and note the difference)",
+    )

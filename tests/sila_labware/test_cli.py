@@ -97,9 +97,19 @@ def test_serve_prints_servers_and_stops_everything_quickly(
     tmp_path: Path, stop_signal: signal.Signals
 ) -> None:
     port_base = free_port_base(4)
-    ca_file = tmp_path / "ca.pem"
+    ca_file, inventory = tmp_path / "ca.pem", tmp_path / "inventory.json"
     serve = subprocess.Popen(
-        [*CLI, "serve", "--port-base", str(port_base), "--ca-file", str(ca_file), "--no-discovery"],
+        [
+            *CLI,
+            "serve",
+            "--port-base",
+            str(port_base),
+            "--ca-file",
+            str(ca_file),
+            "--no-discovery",
+            "--inventory",
+            str(inventory),
+        ],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
@@ -126,6 +136,9 @@ def test_serve_prints_servers_and_stops_everything_quickly(
         assert serve.wait(timeout=10) == 0
         assert time.monotonic() - started < 5.0
         assert not any(_pid_alive(pid) for pid in child_pids)
+        # the robot side kept its inventory where it was told to: the plate its sensors saw, by its label
+        records = json.loads(inventory.read_text())
+        assert [(r["labware_id"], r["location"]) for r in records] == [("plate_001", "station:station_a:1")]
     finally:
         if serve.poll() is None:
             serve.kill()
