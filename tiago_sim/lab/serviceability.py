@@ -59,7 +59,7 @@ where that approach may end: with the circle taken as 0.35 m and no margin, a wo
 from its bench let the tray touch it (the base ended 12 mm nearer than its working pose)."""
 REACH_ARM = "right"
 LOOK_TORSO_LIFT = 0.15
-"""The torso height of "Home", where the first look at a station's marker is taken (m)."""
+"""The torso height of "Travel", where the first look at a station's marker is taken (m)."""
 CAMERA_FOCAL_PX = 522.2
 MARKER_DISTANCE_RANGE = (0.4, 1.6)
 """Camera to marker centre (m): the camera clips at 0.3 m; beyond 1.5 to 2.5 m detection failed."""

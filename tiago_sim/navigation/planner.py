@@ -1,7 +1,7 @@
 """Global path planning on the occupancy map: A* on the inflated grid, then straight segments.
 
 Why this shape: the robot turns in place at every corner of its path, and there it sweeps a circle
-of ``ROBOT_RADIUS_M``: the folded arms (Home/Tuck) reach 0.48 m sideways from the base centre, the
+of ``ROBOT_RADIUS_M``: the folded arms (Travel/Tuck) reach 0.48 m sideways from the base centre, the
 onboard hotel tray's corner 0.354 m ahead, the base itself 0.265 m. So the planning map is the
 static map inflated by that radius plus a margin: a cell free there is a cell where the robot may
 stand and turn. A* (8-connected, octile heuristic)
@@ -34,7 +34,7 @@ from tiago_sim.robot.hotel_model import hotel_sweep_radius
 from tiago_sim.robot.robot_model import BASE_RADIUS
 
 ARM_SWEEP_RADIUS_M = 0.48
-"""The folded arms' farthest point from the base centre in the travel pose (Home/Tuck, torso at
+"""The folded arms' farthest point from the base centre in the travel pose (Travel/Tuck, torso at
 0.15 m): arm_*_4_link at 0.479 m, sideways, from 0.74 m above the floor up, so over a bench top too
 (tests/tiago_sim/physics/test_sim_collisions.py probes it in PyBullet; an arm grazed bench_c's top
 when the robot drove straight at it)."""

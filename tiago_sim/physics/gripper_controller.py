@@ -141,7 +141,7 @@ class Gripper:
         """After a physics step: the attached plate's load; lets go of it if friction could not hold it."""
         if self._grip_monitor is None:
             return None
-        load = self._grip_monitor.load(dt, self.body.link_pose(f"arm_{self.side}_grasping_frame"))
+        load = self._grip_monitor.load(dt, self.body.link_pose(f"gripper_{self.side}_grasping_frame"))
         if not load.holds:
             log.warning("%s gripper: %s slips: %s", self.side, self.attached_id, load.describe())
             self.slipped_id, self.last_slip = self.attached_id, load

@@ -75,9 +75,10 @@ DRIVE_CONSTRAINT_ERP = 0.66  # the same lag at 1/30 s: 17.2 ms at 0.27 and 0.53 
 LOADED_TURN_RATE = 0.05  # rad/s: above it, with an unclamped plate in the hotel, steps stay short
 DOCK_SENSOR_RANGE = 0.004  # m: the charging contacts close within this distance
 TOOL_SPEED = 0.08  # m/s along straight tool moves unless the caller asks otherwise
-# Arms folded beside the torso (PAL's "home"), head level.
-HOME_ARM = (0.2, -1.1, -0.2, 1.94, -1.57, 1.37, 0.0)
-HOME_TORSO = 0.15
+# The posture the simulation starts in: arms folded beside the torso (the "Travel" motion's
+# keyframe), head level. Not PAL's `home` motion, whose joint values differ.
+START_ARM = (0.2, -1.1, -0.2, 1.94, -1.57, 1.37, 0.0)
+START_TORSO = 0.15
 
 
 class Simulation:
@@ -105,7 +106,7 @@ class Simulation:
             physicsClientId=c,
         )
         self.robot = RobotBody(c, world.dock_pose.matrix())
-        self.robot.reset_posture(HOME_TORSO, HOME_ARM)
+        self.robot.reset_posture(START_TORSO, START_ARM)
         self.T_world_slot_at_start = {
             i: self.robot.link_pose(f"hotel_slot_{i}") for i in range(1, world.hotel_slots + 1)
         }
@@ -119,7 +120,7 @@ class Simulation:
         self._clamped_for_drive = False
         self.plate_proximity = PlateProximity(c, self.robot, self.scene.plates, self.grippers)
         self.kinematics = RobotKinematics()
-        # The head camera's true mount against the model's head_camera_optical_frame (a hand-eye
+        # The head camera's true mount against the model's head_front_camera_rgb_optical_frame (a hand-eye
         # calibration error; identity unless tiago_sim.measuring.disturbances sets one).
         self.T_camera_mount_error = np.eye(4)
         self.motions: list[Motion] = []
@@ -273,7 +274,7 @@ class Simulation:
 
     def true_camera_pose(self) -> np.ndarray:
         """T_world_optical of the head camera as mounted (ground truth: rendering and checks only)."""
-        return self.robot.link_pose("head_camera_optical_frame") @ self.T_camera_mount_error
+        return self.robot.link_pose("head_front_camera_rgb_optical_frame") @ self.T_camera_mount_error
 
     def nest_readings(self) -> list[NestReading]:
         """Every nest, as its presence sensor sees it (a plate there, and which one)."""

@@ -30,7 +30,7 @@ def plan_tool_path(
 ) -> list[dict[str, float]] | str:
     """Joint positions per waypoint from ``current`` to ``T_base_grasp`` (grasping frame in
     base_footprint), or the reason there are none (an unreachable waypoint, a joint jump)."""
-    T_start = kinematics.forward(current, f"arm_{arm}_grasping_frame")
+    T_start = kinematics.forward(current, f"gripper_{arm}_grasping_frame")
     T_goal = np.asarray(T_base_grasp, dtype=float)
     waypoints = _straight_path(T_start, T_goal) if straight_line else [T_goal]
     solutions: list[dict[str, float]] = []

@@ -22,7 +22,7 @@ from tiago_sim.robot import robot_model
 
 log = logging.getLogger(__name__)
 
-CAMERA_FRAME = "head_camera_optical_frame"
+CAMERA_FRAME = "head_front_camera_rgb_optical_frame"
 IK_DAMPING = 1e-3
 IK_POSITION_TOLERANCE = 5e-4  # m
 IK_ORIENTATION_TOLERANCE = 2e-3  # rad
@@ -88,7 +88,7 @@ class RobotKinematics:
         seed: int = 0,
         max_iterations: int = 150,
     ) -> IkResult:
-        """Joint positions that put ``arm_<arm>_grasping_frame`` at ``T_base_target``.
+        """Joint positions that put ``gripper_<arm>_grasping_frame`` at ``T_base_target``.
 
         Damped least squares (damping 1e-3) with joint-limit clamping; the first attempt starts
         from ``seed_positions`` (so the nearest solution wins), then seeded random restarts.
@@ -97,7 +97,7 @@ class RobotKinematics:
         if use_torso:
             names = ["torso_lift_joint", *names]
         indices = np.array([self.joint_index(name) for name in names])
-        frame_id = self.model.getFrameId(f"arm_{arm}_grasping_frame")
+        frame_id = self.model.getFrameId(f"gripper_{arm}_grasping_frame")
         target = pin.SE3(np.asarray(T_base_target, dtype=float))
         rng = np.random.default_rng(seed)
         q_start = self._q(seed_positions)

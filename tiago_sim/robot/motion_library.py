@@ -1,6 +1,6 @@
 """Named keyframe motions of the robot (PlayMotion), read from motions.yaml.
 
-Fixed motions ("Home", "Benchtop") are joint-space keyframes written for the right arm; the left
+Fixed motions ("Travel", "Benchtop") are joint-space keyframes written for the right arm; the left
 arm is the mirror image of the right in our model, so the same joint values serve it (joint
 names carry a "{side}" placeholder). The hotel motions ("NestApproach", "Nest") depend on the
 slot and are derived from the hotel slot frame of the robot model by IK when played: the grasping

@@ -13,7 +13,7 @@ Modelling choices (see also README.md, "The world file"):
 - Gripper: two prismatic fingers, 0..0.045 m each, like PAL's. Our fingers sit 5 mm further out
   than PAL's, so the gap runs from 10 mm (closed) to 100 mm (open) instead of 0..90 mm: 7.3 mm
   clearance per side over a microplate's 85.48 mm short side. Pads are 80 mm wide.
-- ``arm_<side>_grasping_frame``: origin between the finger pads, x = approach direction (out of
+- ``gripper_<side>_grasping_frame``: origin between the finger pads, x = approach direction (out of
   the palm), y = closing axis of the fingers (towards the left finger), z = x cross y.
 - Onboard hotel: a tray on the base front with two pockets; fixed links ``hotel_slot_<n>`` lie on
   the pocket floor centre, x along the plate's long side, z up.
@@ -216,12 +216,12 @@ def _add_torso_and_head(w: UrdfWriter) -> None:
         (0.091, 0.0805, -0.022),
         (-math.pi / 2, 0, 0),
     )
-    w.link("head_camera_optical_frame")
+    w.link("head_front_camera_rgb_optical_frame")
     w.joint(
         "head_camera_optical_joint",
         "fixed",
         "head_camera_link",
-        "head_camera_optical_frame",
+        "head_front_camera_rgb_optical_frame",
         (0, 0, 0),
         (-math.pi / 2, 0, -math.pi / 2),
     )
@@ -312,9 +312,13 @@ def _add_gripper(w: UrdfWriter, side: str, tool: str) -> None:
             effort=FINGER_EFFORT,
             velocity=FINGER_SPEED,
         )
-    w.link(f"arm_{side}_grasping_frame")
+    w.link(f"gripper_{side}_grasping_frame")
     w.joint(
-        f"arm_{side}_grasping_frame_joint", "fixed", tool, f"arm_{side}_grasping_frame", (TOOL_TO_GRASP, 0, 0)
+        f"gripper_{side}_grasping_frame_joint",
+        "fixed",
+        tool,
+        f"gripper_{side}_grasping_frame",
+        (TOOL_TO_GRASP, 0, 0),
     )
 
 

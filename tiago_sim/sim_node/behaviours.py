@@ -104,10 +104,10 @@ class RobotBehaviours:
         return {}
 
     def _lower_torso(self, run: ActionRun) -> Any:
-        """Start the torso down to the travel height of "Home" (it runs while the base drives)."""
+        """Start the torso down to the travel height of "Travel" (it runs while the base drives)."""
         travel = [
             frame["torso_lift_joint"]
-            for frame in self.motions.keyframes.get("Home", [])
+            for frame in self.motions.keyframes.get("Travel", [])
             if "torso_lift_joint" in frame
         ]
         if not travel:
@@ -176,7 +176,7 @@ class RobotBehaviours:
 
     def tool_pose(self, arm: str, joint_positions: dict[str, float]) -> np.ndarray:
         with self._kinematics_lock:
-            return self._kinematics.forward(joint_positions, f"arm_{arm}_grasping_frame")
+            return self._kinematics.forward(joint_positions, f"gripper_{arm}_grasping_frame")
 
     def grasp_twin(self, arm: str, T_base_grasp: np.ndarray, seed: dict[str, float]) -> np.ndarray:
         """A top-down grasp pose or its twin with the fingers swapped (half-turn about the approach).

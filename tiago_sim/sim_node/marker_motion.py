@@ -44,7 +44,7 @@ log = logging.getLogger(__name__)
 
 TARGETS = ("site_approach", "site", "work_pose")
 LINE_ONLY_RADIUS_M = 0.03  # a tool this near the column above the site moves only in straight lines
-CAMERA_FRAME = "head_camera_optical_frame"
+CAMERA_FRAME = "head_front_camera_rgb_optical_frame"
 # A cached marker stays valid while odometry moved less than this.
 SAME_BASE_POSITION_M = 0.002
 SAME_BASE_YAW_RAD = 0.003

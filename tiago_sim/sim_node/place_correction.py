@@ -93,7 +93,7 @@ def place_shift(
         return None
     T_site_base = tf.invert(T_base_site)
     points = site_points(depth, intrinsics, T_site_base @ forward(joints, camera_frame))
-    T_site_tool = T_site_base @ forward(joints, f"arm_{arm}_grasping_frame")
+    T_site_tool = T_site_base @ forward(joints, f"gripper_{arm}_grasping_frame")
     tool = T_site_tool[:3, 3]
     sighting: HeldPlateSighting | None = None
     for plate in plate_types:

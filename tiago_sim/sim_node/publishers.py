@@ -37,7 +37,7 @@ log = logging.getLogger(__name__)
 
 CAMERA_IMAGE_TOPIC = "/head_front_camera/rgb/image_raw"
 CAMERA_INFO_TOPIC = "/head_front_camera/rgb/camera_info"
-CAMERA_FRAME = "head_camera_optical_frame"
+CAMERA_FRAME = "head_front_camera_rgb_optical_frame"
 # The robot state and station states go out at least this often (s), news or not: a reader's
 # clock (SimulatedLabController.SimulatedTime reads the last /robot_state's stamp) is never staler.
 SLOW_PERIOD_S = 0.5

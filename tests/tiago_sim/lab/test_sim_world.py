@@ -123,11 +123,11 @@ def test_moving_a_station_is_a_yaml_edit(tmp_path):
 
 
 def test_head_camera_and_arm_frames_match_the_tiago_figures():
-    camera = forward({}, "head_camera_optical_frame")
+    camera = forward({}, "head_front_camera_rgb_optical_frame")
     np.testing.assert_allclose(camera[:3, 3], [0.216, 0.022, 1.067], atol=1e-3)
     # OpenCV optical frame: z forward (base x), x right (base -y), y down (base -z)
     np.testing.assert_allclose(camera[:3, :3], [[0, 0, 1], [-1, 0, 0], [0, -1, 0]], atol=1e-9)
-    lifted = forward({"torso_lift_joint": 0.2}, "head_camera_optical_frame")
+    lifted = forward({"torso_lift_joint": 0.2}, "head_front_camera_rgb_optical_frame")
     assert lifted[2, 3] == pytest.approx(1.267, abs=1e-3)
     right = forward({}, "arm_right_1_link")
     left = forward({}, "arm_left_1_link")
@@ -141,5 +141,5 @@ def test_urdf_declares_the_joint_limits_of_the_table():
     for side in robot_model.ARM_SIDES:
         for name in robot_model.arm_joint_names(side) + robot_model.finger_joint_names(side):
             assert f'name="{name}"' in text
-        assert f'name="arm_{side}_grasping_frame"' in text
+        assert f'name="gripper_{side}_grasping_frame"' in text
     assert 'name="hotel_slot_1"' in text and 'name="hotel_slot_2"' in text

@@ -27,7 +27,7 @@ from tiago_sim.physics.simulation import Simulation
 from tiago_sim.robot import robot_model as rm
 from tiago_sim.sim_node.base_alignment import head_angles_towards
 
-CAMERA_FRAME = "head_camera_optical_frame"
+CAMERA_FRAME = "head_front_camera_rgb_optical_frame"
 STATION = "station_a"
 SEED = 40010
 MAX_MARKER_POSITION_ERROR_M = 0.003  # the perception error budget (README, benchmark targets)
@@ -153,7 +153,7 @@ def test_joint_offsets_shift_the_readings_and_the_poses_fk_gives(sim_at_marker):
     readings = sim.joint_positions()
     for name, target in arm.items():
         assert readings[name] == pytest.approx(target, abs=SETTLE_TOLERANCE)
-    frame = "arm_right_grasping_frame"
+    frame = "gripper_right_grasping_frame"
     believed = sim.kinematics.forward(readings, frame)
     true_tool = tf.invert(sim.robot.base_pose()) @ sim.robot.link_pose(frame)
     from_true_joints = sim.kinematics.forward(

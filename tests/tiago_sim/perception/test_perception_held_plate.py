@@ -162,14 +162,17 @@ def test_the_place_shift_is_free_of_the_camera_calibration_error(yaw_deg: float,
         FLIP_ABOUT_APPROACH if flipped else np.eye(4)
     )
     T_base_tool = T_WORLD_SITE @ tf.make_transform((*tool_xy, APPROACH)) @ grasp
-    frames = {"head_camera_optical_frame": T_base_optical_believed, "arm_right_grasping_frame": T_base_tool}
+    frames = {
+        "head_front_camera_rgb_optical_frame": T_base_optical_believed,
+        "gripper_right_grasping_frame": T_base_tool,
+    }
     joints = {"head_1_joint": 0.1, "head_2_joint": -0.9}
     shift = place_shift(
         lambda: (depth, CameraIntrinsics(), joints),
         lambda _joints, frame: frames[frame],
         T_base_site_believed,
         "right",
-        "head_camera_optical_frame",
+        "head_front_camera_rgb_optical_frame",
         dict(joints),
         [PLATE],
         GRASP_HEIGHT,
@@ -190,13 +193,16 @@ def test_the_place_shift_is_free_of_the_camera_calibration_error(yaw_deg: float,
 def test_no_shift_once_the_head_has_turned_but_one_while_it_settles(pan_then: float, measured: bool):
     depth, T_world_optical = _render((0.0, 0.0), (0.0, 0.0))
     T_world_tool = T_WORLD_SITE @ tf.make_transform((0.0, 0.0, APPROACH + GRASP_HEIGHT))
-    frames = {"head_camera_optical_frame": T_world_optical, "arm_right_grasping_frame": T_world_tool}
+    frames = {
+        "head_front_camera_rgb_optical_frame": T_world_optical,
+        "gripper_right_grasping_frame": T_world_tool,
+    }
     shift = place_shift(
         lambda: (depth, CameraIntrinsics(), {"head_1_joint": 0.1, "head_2_joint": -0.9}),
         lambda _joints, frame: frames[frame],
         T_WORLD_SITE,
         "right",
-        "head_camera_optical_frame",
+        "head_front_camera_rgb_optical_frame",
         {"head_1_joint": pan_then, "head_2_joint": -0.9},
         [PLATE],
         GRASP_HEIGHT,

@@ -70,7 +70,7 @@ def test_a_straight_drive_through_the_bench_is_stopped_as_a_collision(
 def test_the_travel_pose_sweeps_no_farther_than_the_planners_robot_radius() -> None:
     """A thin upright plate probed around the robot at 72 bearings: the nearest robot point's
     distance from the base centre is the radius the robot sweeps when it turns in place."""
-    sim = Simulation(load_world(DEFAULT_WORLD), seed=1)  # docked, arms in Home, torso at 0.15 m
+    sim = Simulation(load_world(DEFAULT_WORLD), seed=1)  # docked, arms in Travel, torso at 0.15 m
     client = sim.client_id
     x, y, _ = sim.robot.base_xy_yaw()
     shape = p.createCollisionShape(p.GEOM_BOX, halfExtents=[0.005, 0.02, 1.0], physicsClientId=client)

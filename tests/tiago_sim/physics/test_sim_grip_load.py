@@ -129,7 +129,7 @@ def test_the_step_where_the_physics_step_changes_length_counts_no_acceleration()
     try:
         client, plate = sim.client_id, sim.scene.plates[PLATE]
         monitor = GripLoadMonitor(client, sim.robot.id, plate, sim.grippers[ARM].finger_links, 16.0)
-        grasp = sim.robot.link_pose(f"arm_{ARM}_grasping_frame")
+        grasp = sim.robot.link_pose(f"gripper_{ARM}_grasping_frame")
         along = grasp[:3, 0]  # in the pad plane
         p.resetBaseVelocity(plate, [0.0, 0.0, 0.0], physicsClientId=client)
         monitor.load(1 / 60, grasp)

@@ -19,7 +19,7 @@ from tests.helpers.sim_steps import step_for, step_lengths
 from tiago_sim import transforms as tf
 from tiago_sim.lab.world import load_world
 from tiago_sim.physics.plate_proximity import CONTACT_MARGIN, STEP_REVIEW_PERIOD
-from tiago_sim.physics.simulation import FREE_MOTION_STEP_RATIO, HOME_ARM, TOOL_SPEED, Simulation
+from tiago_sim.physics.simulation import FREE_MOTION_STEP_RATIO, START_ARM, TOOL_SPEED, Simulation
 from tiago_sim.robot import robot_model as rm
 from tiago_sim.robot.kinematics import top_down_grasp
 
@@ -50,7 +50,9 @@ class Script:
         return tf.invert(self.sim.robot.base_pose()) @ self.sim.plate_bottom_pose(PLATE)
 
     def plate_in_grasp(self) -> np.ndarray:
-        T_base_grasp = self.sim.kinematics.forward(self.sim.joint_positions(), f"arm_{ARM}_grasping_frame")
+        T_base_grasp = self.sim.kinematics.forward(
+            self.sim.joint_positions(), f"gripper_{ARM}_grasping_frame"
+        )
         return tf.invert(T_base_grasp) @ self.plate_in_base()
 
     def pick(self, T_base_site: np.ndarray) -> None:
@@ -102,7 +104,7 @@ def test_plate_goes_from_station_a_through_the_hotel_to_station_b():
             HotelSlotReading(HotelSlot(1), PLATE, "sbs_microplate_96"),
             HotelSlotReading(HotelSlot(2), "", ""),
         ]
-        home = dict(zip(rm.arm_joint_names(ARM), HOME_ARM, strict=True))
+        home = dict(zip(rm.arm_joint_names(ARM), START_ARM, strict=True))
         script.run(sim.move_joints(home), "home")
 
         script.drive("station_b_work")

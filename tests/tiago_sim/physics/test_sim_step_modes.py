@@ -13,7 +13,7 @@ import pybullet as p
 from tests.helpers.sim_steps import step_lengths
 from tiago_sim import transforms as tf
 from tiago_sim.lab.world import load_world
-from tiago_sim.physics.simulation import DRIVE_STEP_RATIO, FREE_MOTION_STEP_RATIO, HOME_ARM, Simulation
+from tiago_sim.physics.simulation import DRIVE_STEP_RATIO, FREE_MOTION_STEP_RATIO, START_ARM, Simulation
 
 PLATE = "plate_001"
 
@@ -37,8 +37,8 @@ def test_driving_takes_the_longest_steps_an_arm_motion_long_ones_and_a_gripper_m
     sim = Simulation(load_world(), seed=4)
     try:
         assert set(step_lengths(sim, sim.undock())) == {sim.time_step * DRIVE_STEP_RATIO}
-        folded = dict(zip([f"arm_right_{i}_joint" for i in range(1, 8)], HOME_ARM, strict=True))
-        unfolded = {**folded, "arm_right_1_joint": HOME_ARM[0] + 0.4}
+        folded = dict(zip([f"arm_right_{i}_joint" for i in range(1, 8)], START_ARM, strict=True))
+        unfolded = {**folded, "arm_right_1_joint": START_ARM[0] + 0.4}
         assert set(step_lengths(sim, sim.move_joints(unfolded))) == {sim.time_step * FREE_MOTION_STEP_RATIO}
         closing = step_lengths(sim, sim.gripper("right", close=True))
         assert closing and set(closing) == {sim.time_step}

@@ -45,7 +45,7 @@ def test_ik_reaches_every_nest_from_its_working_pose_and_both_hotel_slots(kinema
         result = kinematics.inverse("right", target, seed, use_torso=True, seed=index)
         assert result.success, f"target {index} unreachable: {result}"
         q = dict(seed, **result.joint_positions)
-        reached = kinematics.forward(q, "arm_right_grasping_frame")
+        reached = kinematics.forward(q, "gripper_right_grasping_frame")
         assert np.linalg.norm(reached[:3, 3] - target[:3, 3]) < 1e-3
         assert tf.rotation_angle(reached[:3, :3], target[:3, :3]) < 3e-3
         for name, value in result.joint_positions.items():
@@ -69,9 +69,9 @@ def test_pinocchio_fk_matches_pybullet_link_poses():
         joints = sim.joint_positions()
         T_world_base = sim.robot.base_pose()
         for frame in (
-            "head_camera_optical_frame",
-            "arm_right_grasping_frame",
-            "arm_left_grasping_frame",
+            "head_front_camera_rgb_optical_frame",
+            "gripper_right_grasping_frame",
+            "gripper_left_grasping_frame",
             "hotel_slot_2",
         ):
             from_pinocchio = sim.kinematics.forward(joints, frame)

@@ -454,7 +454,7 @@ def test_second_motion_while_busy_is_refused_and_cancel_stops_safely(robot: RosC
             "the final approach running",
         )
         assert not ended.done(), f"GetLabware ended before its approach: {ended.result().result.message}"
-        home = PlayMotion.Goal(motion_name="Home")
+        home = PlayMotion.Goal(motion_name="Travel")
         busy = robot.call_action(PlayMotion, "/play_motion", home, timeout_s=30.0)
     finally:
         set_sim_float(robot, "realtime_factor_cap", 0.0)

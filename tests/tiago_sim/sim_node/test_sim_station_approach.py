@@ -76,7 +76,7 @@ def test_head_angles_point_the_camera_at_the_target():
     joints = {"torso_lift_joint": 0.15}
     target = np.array([0.78, -0.14, 0.84])  # where a station marker lies seen from its POI
     joints.update(head_angles_towards(kinematics, joints, target))
-    camera = kinematics.forward(joints, "head_camera_optical_frame")
+    camera = kinematics.forward(joints, "head_front_camera_rgb_optical_frame")
     to_target = target - camera[:3, 3]
     angle = math.acos(float(camera[:3, 2] @ to_target / np.linalg.norm(to_target)))
     assert math.degrees(angle) < 1.0  # the marker lands in the middle of the image
