@@ -80,8 +80,8 @@ def test_cancel_passes_through(echo_server, runtime: RosRuntime) -> None:
 
 def test_topic_mirror_sees_publisher_in_other_process(echo_server, runtime: RosRuntime) -> None:
     changes: list[str] = []
-    mirror = TopicMirror(runtime, RobotState, "/robot_state")
-    mirror.add_listener(lambda message: changes.append(message.detail))
+    # the listener from the start: one added after the subscription may miss the first message
+    mirror = TopicMirror(runtime, RobotState, "/robot_state", listeners=[lambda m: changes.append(m.detail)])
     first = mirror.wait_for_message(timeout_s=15.0)
     assert first.state == RobotState.STATE_IDLE and first.detail.startswith("finished ")
     time.sleep(0.5)

@@ -75,8 +75,7 @@ DRIVE_CONSTRAINT_ERP = 0.66  # the same lag at 1/30 s: 17.2 ms at 0.27 and 0.53 
 LOADED_TURN_RATE = 0.05  # rad/s: above it, with an unclamped plate in the hotel, steps stay short
 DOCK_SENSOR_RANGE = 0.004  # m: the charging contacts close within this distance
 TOOL_SPEED = 0.08  # m/s along straight tool moves unless the caller asks otherwise
-# The posture the simulation starts in: arms folded beside the torso (the "Travel" motion's
-# keyframe), head level. Not PAL's `home` motion, whose joint values differ.
+# The start posture: arms folded (as in "Travel"), head level; not PAL's `home` (other values).
 START_ARM = (0.2, -1.1, -0.2, 1.94, -1.57, 1.37, 0.0)
 START_TORSO = 0.15
 
