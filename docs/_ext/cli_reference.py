@@ -12,6 +12,7 @@ import argparse
 from docutils import nodes
 from sphinx.application import Sphinx
 from sphinx.util.docutils import SphinxDirective
+from tables import table
 
 
 def _subcommands(parser: argparse.ArgumentParser) -> list[tuple[str, argparse.ArgumentParser, str]]:
@@ -42,28 +43,6 @@ def _option_rows(parser: argparse.ArgumentParser) -> list[tuple[str, str]]:
     return rows
 
 
-def _table(rows: list[tuple[str, str]]) -> nodes.table:
-    table = nodes.table()
-    group = nodes.tgroup(cols=2)
-    table += group
-    group += nodes.colspec(colwidth=35)
-    group += nodes.colspec(colwidth=65)
-    head = nodes.thead()
-    group += head
-    header = nodes.row()
-    for title in ("option", "what it does"):
-        header += nodes.entry("", nodes.paragraph(text=title))
-    head += header
-    body = nodes.tbody()
-    group += body
-    for name, text in rows:
-        row = nodes.row()
-        row += nodes.entry("", nodes.paragraph("", "", nodes.literal(text=name)))
-        row += nodes.entry("", nodes.paragraph(text=text))
-        body += row
-    return table
-
-
 class CliReference(SphinxDirective):
     has_content = False
 
@@ -77,7 +56,7 @@ class CliReference(SphinxDirective):
         section += nodes.literal_block(usage, usage, language="text")
         rows = _option_rows(parser)
         if rows:
-            section += _table(rows)
+            section += table(("option", "what it does"), (35, 65), rows)
         for name, sub, sub_help in _subcommands(parser):
             section += self._section(f"{title} {name}", sub, sub_help)
         return section

@@ -16,6 +16,7 @@ from pathlib import Path
 from docutils import nodes
 from sphinx.application import Sphinx
 from sphinx.util.docutils import SphinxDirective
+from tables import table
 
 FEATURES = Path(__file__).resolve().parents[2] / "features"
 NS = {"s": "http://www.sila-standard.org"}
@@ -26,29 +27,6 @@ def _text(element: ElementTree.Element | None, tag: str) -> str:
     if found is None or found.text is None:
         return ""
     return re.sub(r"\s+", " ", found.text).strip()
-
-
-def _table(titles: tuple[str, ...], rows: list[tuple[str, ...]], widths: tuple[int, ...]) -> nodes.table:
-    table = nodes.table()
-    group = nodes.tgroup(cols=len(titles))
-    table += group
-    for width in widths:
-        group += nodes.colspec(colwidth=width)
-    head = nodes.thead()
-    group += head
-    row = nodes.row()
-    for title in titles:
-        row += nodes.entry("", nodes.paragraph(text=title))
-    head += row
-    body = nodes.tbody()
-    group += body
-    for cells in rows:
-        row = nodes.row()
-        for index, cell in enumerate(cells):
-            inner = nodes.literal(text=cell) if index == 0 and cell else nodes.Text(cell)
-            row += nodes.entry("", nodes.paragraph("", "", inner))
-        body += row
-    return table
 
 
 def _errors_of(element: ElementTree.Element) -> list[str]:
@@ -81,7 +59,7 @@ class SilaFeature(SphinxDirective):
                 (_text(prop, "Identifier"), kind, _text(prop, "Description"), ", ".join(_errors_of(prop)))
             )
         if rows:
-            box += _table(("name", "kind", "what it does", "defined errors"), rows, (16, 12, 52, 20))
+            box += table(("name", "kind", "what it does", "defined errors"), (16, 12, 52, 20), rows)
         return [box]
 
 
@@ -95,7 +73,7 @@ class SilaErrors(SphinxDirective):
                 rows.append(
                     (_text(error, "Identifier"), _text(root, "Identifier"), _text(error, "Description"))
                 )
-        return [_table(("error", "feature", "when"), rows, (22, 22, 56))]
+        return [table(("error", "feature", "when"), (22, 22, 56), rows)]
 
 
 def setup(app: Sphinx) -> dict[str, object]:

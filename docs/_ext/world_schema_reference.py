@@ -12,6 +12,7 @@ from typing import Any
 from docutils import nodes
 from sphinx.application import Sphinx
 from sphinx.util.docutils import SphinxDirective
+from tables import table
 
 _RANGE_WORDS = {
     "minimum": ">=",
@@ -61,37 +62,21 @@ def _range(spec: dict[str, Any]) -> str:
     return "; ".join(parts)
 
 
-def _entry(text: str, literal: bool = False) -> nodes.entry:
-    inner = nodes.literal(text=text) if literal else nodes.Text(text)
-    return nodes.entry("", nodes.paragraph("", "", inner))
-
-
 def _object_table(properties: dict[str, Any], required: set[str]) -> nodes.table:
-    titles = ("key", "type", "required", "default", "range", "description")
-    widths = (14, 18, 8, 10, 14, 36)
-    table = nodes.table()
-    group = nodes.tgroup(cols=len(titles))
-    table += group
-    for width in widths:
-        group += nodes.colspec(colwidth=width)
-    head = nodes.thead()
-    group += head
-    row = nodes.row()
-    for title in titles:
-        row += _entry(title)
-    head += row
-    body = nodes.tbody()
-    group += body
-    for key, spec in properties.items():
-        row = nodes.row()
-        row += _entry(key, literal=True)
-        row += _entry(_type(spec))
-        row += _entry("yes" if key in required else "")
-        row += _entry(repr(spec["default"]) if "default" in spec else "")
-        row += _entry(_range(spec))
-        row += _entry(spec.get("description", ""))
-        body += row
-    return table
+    rows = [
+        (
+            key,
+            _type(spec),
+            "yes" if key in required else "",
+            repr(spec["default"]) if "default" in spec else "",
+            _range(spec),
+            spec.get("description", ""),
+        )
+        for key, spec in properties.items()
+    ]
+    return table(
+        ("key", "type", "required", "default", "range", "description"), (14, 18, 8, 10, 14, 36), rows
+    )
 
 
 class WorldSchemaReference(SphinxDirective):
