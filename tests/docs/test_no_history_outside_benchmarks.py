@@ -48,4 +48,4 @@ def test_the_rule_finds_what_it_is_meant_to_find() -> None:
     assert history_in("random layout 91028 put a pad") and history_in("seed 2041 stopped")
     assert history_in("`bench --replay 10145`")
     assert not history_in("port 50052, 127.0.0.1, 0.265 m, 1,071 results, decade, 2 cores, seed 1")
-    assert not history_in("server_uuid 6c1e, colour #4a91838, sub-position 12")
+    assert not history_in("server_uuid 6c1e, colour #4a9b3cd, sub-position 12")

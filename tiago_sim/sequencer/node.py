@@ -58,11 +58,11 @@ from tiago_sim.sequencer.plans import (
     STATE_REFUSALS,
     Step,
     TaskRefused,
+    ends_of,
     get_plan,
     label_at_source,
     put_plan,
     retreat_steps,
-    source_of,
 )
 from tiago_sim.sequencer.postconditions import topic_of, unmet
 from tiago_sim.sequencer.step_durations import StepDurations, table_from_parameters
@@ -222,7 +222,7 @@ class Sequencer:
             result.labware_id = request.labware_id
             if self.active is not None:
                 return self._finish(goal_handle, result, ErrorCodes.BUSY, "busy with another transfer")
-            source = source_of(request, kind is PutLabware)
+            source, destination = ends_of(request, kind is PutLabware)
             try:
                 plan = await self._plan(request, make_plan, arrived=time.monotonic())
                 label = label_at_source(request, self.robot_state, self.station_states, kind is PutLabware)
@@ -230,7 +230,6 @@ class Sequencer:
                 result.labware_id = self.inventory.name_for_goal(request, source, label, checks)
             except (TaskRefused, StepFailed) as refusal:
                 return self._finish(goal_handle, result, refusal.code, refusal.message)
-            destination = source_of(request, kind is GetLabware)
             self.step_durations.table = table_from_parameters(
                 {key: float(self.param(f"estimates_s.{key}")) for key in self.estimate_keys}
             )

@@ -113,11 +113,11 @@ def hotel_slot_state(robot_state: Any, slot: HotelSlot) -> Any | None:
     return None
 
 
-def source_of(request: Any, from_hotel: bool) -> HotelSlot | Nest:
-    """Where a goal takes its plate from: its hotel slot (PutLabware) or its nest (GetLabware)."""
-    if from_hotel:
-        return HotelSlot(request.internal_position)
-    return Nest(request.handover_position, request.sub_position)
+def ends_of(request: Any, from_hotel: bool) -> tuple[HotelSlot | Nest, HotelSlot | Nest]:
+    """Where a goal takes its plate from and where it puts it: (hotel slot, nest) for PutLabware,
+    (nest, hotel slot) for GetLabware."""
+    slot, nest = HotelSlot(request.internal_position), Nest(request.handover_position, request.sub_position)
+    return (slot, nest) if from_hotel else (nest, slot)
 
 
 def label_at_source(request: Any, robot_state: Any, station_states: Any, from_hotel: bool) -> str:
