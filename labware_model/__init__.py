@@ -12,6 +12,6 @@ The bottom layer: pure Python (standard library only), imported by `tiago_sim`, 
   hotel's slot count, the POIs), as /describe_workcell reports it.
 
 Geometry stays with its owner: the world file's poses of tables, markers and nests belong to
-`tiago_sim.lab.world`; here a nest is a name and a number. Everything is frozen and checks its
+`lab_description.world`; here a nest is a name and a number. Everything is frozen and checks its
 values when built (a `ValueError` says which value is wrong), so it is safe on any thread.
 """

@@ -62,7 +62,7 @@ if TYPE_CHECKING:
 
 logger = logging.getLogger("sila_labware")
 
-DEFAULT_WORLD = Path(__file__).resolve().parents[1] / "tiago_sim" / "worlds" / "default.yaml"
+DEFAULT_WORLD = Path(__file__).resolve().parents[1] / "lab_description" / "worlds" / "default.yaml"
 
 
 class _Parser(argparse.ArgumentParser):

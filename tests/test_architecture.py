@@ -1,9 +1,11 @@
 """The layers of the tree, checked: which package may import which, and how long a module may grow.
 
 Why a test: the README's layout table promises that imports run one way (client -> SiLA servers
--> bridge -> ROS interfaces <- robot side) and that the task level a real TIAGo++ keeps (the
-sequencer) imports nothing of the simulation. A promise nobody checks erodes one convenient
-import at a time. Every import statement counts, including those inside functions.
+-> bridge -> ROS interfaces <- robot side), that the task level a real TIAGo++ keeps (the
+sequencer) imports nothing of the simulation, and that the robot's skills and the simulator meet
+only at the hardware port (robot_port), wired together by the start-up (tiago_twin) alone. A
+promise nobody checks erodes one convenient import at a time. Every import statement counts,
+including those inside functions.
 """
 
 from __future__ import annotations
@@ -13,65 +15,69 @@ from collections.abc import Iterator
 from pathlib import Path
 
 REPOSITORY = Path(__file__).resolve().parents[1]
-TOP_PACKAGES = ("labware_model", "ros_bridge", "sila_labware", "tiago_sim")
+TOP_PACKAGES = (
+    "labware_model",
+    "robot_port",
+    "tiago_description",
+    "lab_description",
+    "tiago_skills",
+    "tiago_sim",
+    "tiago_twin",
+    "ros_bridge",
+    "sila_labware",
+)
 MAX_MODULE_LINES = 400
+# The robot as described and the lab as described: what both the skills and the simulator read.
+DESCRIPTIONS = {"tiago_description", "lab_description"}
 
 # Each unit (a subpackage, or a module at a package's root) and the units of ours it may import.
 # A unit may always import itself. Lower layers come first.
 ALLOWED: dict[str, set[str]] = {
     "labware_model": set(),
-    "tiago_sim.transforms": set(),
+    # the hardware port: types and a protocol, the seam between the skills and any robot
+    "robot_port": set(),
+    "tiago_description": set(),
+    "lab_description": {"labware_model", "tiago_description"},
+    # the robot's software: sees the robot only through the port, never the simulator
+    "tiago_skills.perception": {"robot_port", "tiago_description"},
+    "tiago_skills": {"labware_model", "robot_port", *DESCRIPTIONS, "tiago_skills.perception"},
     "tiago_sim.node_main": set(),
-    "tiago_sim.lab": {"labware_model", "tiago_sim.transforms", "tiago_sim.robot"},
-    "tiago_sim.robot": {"tiago_sim.transforms"},
-    "tiago_sim.perception": {"tiago_sim.transforms"},
-    "tiago_sim.navigation": {"labware_model", "tiago_sim.transforms", "tiago_sim.lab", "tiago_sim.robot"},
+    "tiago_sim.navigation": {"labware_model", *DESCRIPTIONS},
     # `world check`: the loader's rules, the planner's paths between POIs, the picture
-    "tiago_sim.inspection": {
-        "labware_model",
-        "tiago_sim.transforms",
-        "tiago_sim.lab",
-        "tiago_sim.robot",
-        "tiago_sim.navigation",
-    },
+    "tiago_sim.inspection": {"labware_model", *DESCRIPTIONS, "tiago_sim.navigation"},
     # random labs and obstacles for campaigns: world files checked as the loader and `world check` do
-    "tiago_sim.layouts": {
-        "tiago_sim.transforms",
-        "tiago_sim.lab",
-        "tiago_sim.robot",
-        "tiago_sim.navigation",
-        "tiago_sim.inspection",
-    },
-    "tiago_sim.physics": {
-        "labware_model",
-        "tiago_sim.transforms",
-        "tiago_sim.lab",
-        "tiago_sim.robot",
-        "tiago_sim.perception",
-        "tiago_sim.navigation",
-    },
+    "tiago_sim.layouts": {*DESCRIPTIONS, "tiago_sim.navigation", "tiago_sim.inspection"},
+    "tiago_sim.physics": {"labware_model", "robot_port", *DESCRIPTIONS, "tiago_sim.navigation"},
     "tiago_sim.measuring": {
         "labware_model",
-        "tiago_sim.transforms",
-        "tiago_sim.lab",
-        "tiago_sim.robot",
-        "tiago_sim.perception",
+        "robot_port",
+        *DESCRIPTIONS,
         "tiago_sim.physics",
         "tiago_sim.navigation",
     },
+    # the simulator's ROS side: the hardware port on the simulation, sensors, the navigation stand-in
     "tiago_sim.sim_node": {
         "labware_model",
-        "tiago_sim.transforms",
+        "robot_port",
+        *DESCRIPTIONS,
         "tiago_sim.node_main",
-        "tiago_sim.lab",
-        "tiago_sim.robot",
-        "tiago_sim.perception",
         "tiago_sim.physics",
         "tiago_sim.measuring",
         "tiago_sim.navigation",
     },
     # the task level: a ROS client of the robot's actions, as on the real robot
-    "tiago_sim.sequencer": {"labware_model", "tiago_sim.node_main", "tiago_sim.lab"},
+    "tiago_sim.sequencer": {"labware_model", "tiago_sim.node_main", "lab_description"},
+    # the start-up: the one unit that imports both the simulator and the skills
+    "tiago_twin": {
+        "robot_port",
+        *DESCRIPTIONS,
+        "tiago_skills",
+        "tiago_skills.perception",
+        "tiago_sim.node_main",
+        "tiago_sim.sim_node",
+        "tiago_sim.physics",
+        "tiago_sim.measuring",
+    },
     "ros_bridge": {"labware_model"},
     "ros_bridge.bluesky": {"labware_model", "ros_bridge"},
     "sila_labware.device": {"labware_model", "ros_bridge"},
@@ -115,6 +121,11 @@ PACKAGE_ROOTS = {top: set() for top in TOP_PACKAGES if top not in ALLOWED}
 # Outside libraries a unit must never import directly (what the house style promises).
 FORBIDDEN_LIBRARIES: dict[str, set[str]] = {
     **{unit: {"sila2"} for unit in ALLOWED if unit.startswith("tiago_sim.")},  # first: the rows below win
+    "robot_port": {"rclpy", "sila2", "pybullet", "cv2", "pinocchio", "yaml"},
+    "tiago_description": {"rclpy", "sila2", "pybullet", "cv2"},
+    "lab_description": {"rclpy", "sila2", "pybullet", "cv2"},
+    "tiago_skills": {"pybullet", "sila2"},
+    "tiago_skills.perception": {"pybullet", "rclpy", "sila2"},
     "labware_model": {"numpy", "rclpy", "sila2", "pybullet", "cv2", "yaml"},
     "ros_bridge": {"sila2", "pybullet", "cv2"},
     "ros_bridge.bluesky": {"sila2", "pybullet", "cv2"},
@@ -175,7 +186,7 @@ def test_imports_run_only_downwards() -> None:
             if imported.split(".")[0] not in TOP_PACKAGES:
                 continue
             target = _unit_of(imported)
-            if target in PACKAGE_ROOTS:  # "from tiago_sim import transforms" names the unit too
+            if target in PACKAGE_ROOTS:  # "from tiago_description import transforms" names the unit too
                 continue
             if target != unit and target not in ALLOWED.get(unit, PACKAGE_ROOTS.get(unit, set())):
                 wrong.append(f"{module} imports {imported} ({unit} -> {target})")

@@ -25,9 +25,9 @@ REPOSITORY = Path(__file__).resolve().parents[2]
 GENERATED = REPOSITORY / "docs" / "_generated"
 # world file -> picture, drawn by `sila-labware world check FILE --png PICTURE`
 PICTURES = {
-    "tiago_sim/worlds/default.yaml": "world_default.png",
-    "tiago_sim/worlds/furnished_lab.yaml": "world_furnished_lab.png",
-    "tiago_sim/worlds/bench_in_the_way.yaml": "world_bench_in_the_way.png",
+    "lab_description/worlds/default.yaml": "world_default.png",
+    "lab_description/worlds/furnished_lab.yaml": "world_furnished_lab.png",
+    "lab_description/worlds/bench_in_the_way.yaml": "world_bench_in_the_way.png",
 }
 
 

@@ -1,6 +1,6 @@
 """`{world-schema}`: the world file's keys, generated from its one definition.
 
-Renders `tiago_sim.lab.world_schema.json_schema()` (the pydantic models' JSON Schema, the same the
+Renders `lab_description.world_schema.json_schema()` (the pydantic models' JSON Schema, the same the
 editors use) as one table per object: key, type, whether it is required, its default, its range and
 its description. The page follows the code; a key added there appears here on the next build.
 """
@@ -83,7 +83,7 @@ class WorldSchemaReference(SphinxDirective):
     has_content = False
 
     def run(self) -> list[nodes.Node]:
-        from tiago_sim.lab.world_schema import json_schema
+        from lab_description.world_schema import json_schema
 
         schema = json_schema()
         self.env.note_dependency(str(self.env.srcdir.parent / "tiago_sim" / "lab" / "world_schema.py"))

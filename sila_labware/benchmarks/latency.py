@@ -53,7 +53,7 @@ from sila_labware.servers.serving import start_sila_server
 
 logger = logging.getLogger(__name__)
 
-DEFAULT_WORLD = Path(__file__).resolve().parents[2] / "tiago_sim" / "worlds" / "default.yaml"
+DEFAULT_WORLD = Path(__file__).resolve().parents[2] / "lab_description" / "worlds" / "default.yaml"
 PEER_START_TIMEOUT_S = 60.0
 
 

@@ -34,7 +34,7 @@ from sila_labware.deployment.stack import Deployment, DeploymentOptions
 
 logger = logging.getLogger(__name__)
 
-DEFAULT_WORLD = Path(__file__).resolve().parents[2] / "tiago_sim" / "worlds" / "default.yaml"
+DEFAULT_WORLD = Path(__file__).resolve().parents[2] / "lab_description" / "worlds" / "default.yaml"
 WATCHED_STEPS = (GET_LABWARE, PUT_LABWARE)
 HALFWAY = 0.5
 

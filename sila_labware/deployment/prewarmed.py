@@ -1,7 +1,7 @@
 """Robot-side children forked from a process that has imported their code already.
 
 Why: a campaign starts a fresh robot side for every trial (`bench`, 200 times), and each fresh
-`python -m tiago_sim.sim_node` spends about 0.6 s of CPU importing rclpy, PyBullet, pinocchio,
+`python -m tiago_twin` spends about 0.6 s of CPU importing rclpy, PyBullet, pinocchio,
 OpenCV and pydantic before it reads its world; the sequencer about 0.2 s. A fork server, started
 once per process that asks (`python -m sila_labware.deployment.prewarmed`), imports those modules
 and then forks each child from that interpreter. Nothing else is shared: the server never
@@ -37,7 +37,7 @@ from collections.abc import Mapping, Sequence
 
 logger = logging.getLogger(__name__)
 
-PRELOADED_MODULES = ("tiago_sim.sim_node.node", "tiago_sim.physics.simulation", "tiago_sim.sequencer.startup")
+PRELOADED_MODULES = ("tiago_twin.startup", "tiago_sim.physics.simulation", "tiago_sim.sequencer.startup")
 """What the fork server imports once: the robot side's nodes and their heavy dependencies."""
 PR_SET_CHILD_SUBREAPER = 36
 PR_SET_NAME = 15

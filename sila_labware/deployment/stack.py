@@ -46,7 +46,7 @@ from sila_labware.servers.tls import CertificateAuthority
 
 logger = logging.getLogger(__name__)
 
-ROBOT_SIDE_MODULES = (("sim_node", "tiago_sim.sim_node"), ("sequencer", "tiago_sim.sequencer"))
+ROBOT_SIDE_MODULES = (("sim_node", "tiago_twin"), ("sequencer", "tiago_sim.sequencer"))
 CHILD_STOP_S = 2.0
 """How long a robot-side child has after SIGTERM before `Deployment.stop` kills it."""
 

@@ -1,6 +1,6 @@
 """`sila-labware world check FILE [--png OUT]`, and the same check before `serve`, `demo` and `bench`.
 
-Why a child process: the world file belongs to the robot side (tiago_sim.lab reads it), and the
+Why a child process: the world file belongs to the robot side (lab_description reads it), and the
 SiLA side imports nothing of the simulation (tests/test_architecture.py); it starts the robot
 side's modules as processes already. Checking before anything starts gives the technician every
 problem of the file at once, in the words of `world check`, instead of the first one after the

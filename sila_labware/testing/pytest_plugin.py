@@ -24,7 +24,7 @@ import pytest
 
 from sila_labware.testing.lab import LabAddresses, SimulatedLabSession
 
-DEFAULT_WORLD = Path(__file__).resolve().parents[2] / "tiago_sim" / "worlds" / "default.yaml"
+DEFAULT_WORLD = Path(__file__).resolve().parents[2] / "lab_description" / "worlds" / "default.yaml"
 SESSIONS = pytest.StashKey[list[SimulatedLabSession]]()
 
 

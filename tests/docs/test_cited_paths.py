@@ -1,6 +1,6 @@
 """Every repository path the documentation cites exists, and every link between pages resolves.
 
-A cited path is a code span that looks like one: `tiago_sim/lab/world.py`, `tests/examples/`,
+A cited path is a code span that looks like one: `lab_description/world.py`, `tests/examples/`,
 `sila_labware/servers/*/feature_implementations/` (a glob), or a shorter path such as
 `physics/seating.py` that must end some path of the repository; a bare `something.py` must name a
 file somewhere in it. ROS names (`/map`, `nav_msgs/Path`), SiLA identifiers and nests
@@ -100,7 +100,9 @@ def test_every_link_to_a_file_resolves(page: Path) -> None:
 
 
 def test_the_rule_sees_paths_and_not_names() -> None:
-    text = "`tiago_sim/lab/world.py`, `/map`, `nav_msgs/Path`, `station_a/1`, `seating.py`, `serve --pace 1`"
-    assert cited_paths(text) == ["tiago_sim/lab/world.py", "seating.py"]
+    text = (
+        "`lab_description/world.py`, `/map`, `nav_msgs/Path`, `station_a/1`, `seating.py`, `serve --pace 1`"
+    )
+    assert cited_paths(text) == ["lab_description/world.py", "seating.py"]
     assert not exists("tests/tiago_sim/physics/test_scene_floor.py")
     assert exists("physics/seating.py") and exists("sila_labware/servers/*/feature_implementations/")

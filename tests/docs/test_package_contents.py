@@ -32,7 +32,7 @@ def packaged() -> list[str]:
 
 def test_no_docs_folder_is_packaged() -> None:
     packages = packaged()
-    assert "sila_labware" in packages and "tiago_sim.worlds" in packages
+    assert "sila_labware" in packages and "lab_description.worlds" in packages
     assert [p for p in packages if "docs" in p.split(".")] == []
 
 

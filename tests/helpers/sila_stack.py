@@ -10,7 +10,7 @@ from sila_labware.deployment.stack import Deployment, DeploymentOptions, ServedS
 from sila_labware.testing.ports import free_port_base
 
 REPOSITORY = Path(__file__).resolve().parents[2]
-DEFAULT_WORLD = REPOSITORY / "tiago_sim" / "worlds" / "default.yaml"
+DEFAULT_WORLD = REPOSITORY / "lab_description" / "worlds" / "default.yaml"
 
 
 def start_stack(

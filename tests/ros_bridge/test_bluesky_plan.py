@@ -27,7 +27,7 @@ from ros_bridge.runtime import RosRuntime
 from tests.helpers.ros_processes import running
 from tests.helpers.sim_parameters import set_node_parameter
 
-DEFAULT_WORLD = Path(__file__).resolve().parents[2] / "tiago_sim" / "worlds" / "default.yaml"
+DEFAULT_WORLD = Path(__file__).resolve().parents[2] / "lab_description" / "worlds" / "default.yaml"
 PLATE = "plate_001"
 STORAGE = Nest("station_a", 1)
 BEAM = Nest("station_b", 1)
@@ -39,7 +39,7 @@ MOVING_STATES = ("navigating", "manipulating")
 def link(tmp_path_factory: pytest.TempPathFactory) -> Iterator[RobotLink]:
     logs = tmp_path_factory.mktemp("bluesky_logs")
     with (
-        running("tiago_sim.sim_node", "--seed", "7", log_path=logs / "sim_node.log") as sim,
+        running("tiago_twin", "--seed", "7", log_path=logs / "sim_node.log") as sim,
         running("tiago_sim.sequencer", log_path=logs / "sequencer.log") as sequencer,
         RosRuntime("bluesky_plan_test") as runtime,
     ):

@@ -160,7 +160,7 @@ def test_robot_device_reads_robot_state_and_refuses_unknown_tasks(runtime: RosRu
 def test_demo_without_the_task_servers_exits_1_naming_what_is_missing(
     runtime: RosRuntime, caplog: pytest.LogCaptureFixture
 ) -> None:
-    world = Path(__file__).resolve().parents[2] / "tiago_sim" / "worlds" / "default.yaml"
+    world = Path(__file__).resolve().parents[2] / "lab_description" / "worlds" / "default.yaml"
     with caplog.at_level(logging.ERROR, logger="ros_bridge.bluesky.demo"):
         # 3 s: enough for a fresh participant to discover the echo server's navigate action
         assert run_bluesky_demo(world, ready_timeout_s=3.0) == 1

@@ -17,8 +17,8 @@ from pathlib import Path
 from tests.helpers.run_script import REPOSITORY, RUN, assert_set_up
 
 SILA_LABWARE = str(Path(sys.executable).with_name("sila-labware"))
-WORLD = "tiago_sim/worlds/default.yaml"
-WORLD_SUMMARY = "default lab: tiago_sim/worlds/default.yaml"
+WORLD = "lab_description/worlds/default.yaml"
+WORLD_SUMMARY = "default lab: lab_description/worlds/default.yaml"
 
 
 def test_world_check_summarises_the_shipped_world() -> None:

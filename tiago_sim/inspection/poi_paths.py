@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from itertools import combinations
 
-from tiago_sim.lab.world import World
+from lab_description.world import World
 from tiago_sim.navigation.planner import GlobalPlanner, Plan, PlanningError, world_planner
 
 

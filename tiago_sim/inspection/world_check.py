@@ -19,9 +19,9 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TextIO
 
+from lab_description.world import World, WorldError, load_world
 from labware_model.holders import HotelSlot, Nest
 from tiago_sim.inspection.poi_paths import PoiPaths, plan_poi_paths
-from tiago_sim.lab.world import World, WorldError, load_world
 
 INVALID_WORLD_EXIT_CODE = 1
 

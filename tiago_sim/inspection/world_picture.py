@@ -18,12 +18,12 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle, Polygon
 
+from lab_description.world import Pose2D, Station, World
 from labware_model.holders import Nest
-from tiago_sim import transforms as tf
+from tiago_description import transforms as tf
+from tiago_description.robot_model import BASE_RADIUS
 from tiago_sim.inspection.poi_paths import PoiPaths
-from tiago_sim.lab.world import Pose2D, Station, World
 from tiago_sim.navigation.planner import ROBOT_RADIUS_M
-from tiago_sim.robot.robot_model import BASE_RADIUS
 
 BASE_RADIUS_M = BASE_RADIUS
 SWEEP_RADIUS_M = ROBOT_RADIUS_M

@@ -14,7 +14,7 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from tiago_sim.lab.world import WorldError
+from lab_description.world import WorldError
 from tiago_sim.layouts.generator import LayoutError
 from tiago_sim.layouts.layout_file import write_layout
 

@@ -17,8 +17,8 @@ import math
 import random
 from typing import Any
 
+from lab_description.world import World, WorldError, world_from_raw
 from tiago_sim.inspection.poi_paths import plan_poi_paths
-from tiago_sim.lab.world import World, WorldError, world_from_raw
 from tiago_sim.layouts.generator import LayoutError
 
 COUNT = (1, 3)

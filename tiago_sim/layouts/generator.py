@@ -3,7 +3,7 @@
 Why: the robot was tuned on one lab; a lab integrator writes their own file. A layout drawn here
 varies everything the world file lets them choose, within the schema's ranges and what the robot
 can physically serve (`RANGES`, README "Random layouts"), and every layout passes the loader,
-robot checks included (`tiago_sim.lab.serviceability`). Same seed, same layout (Python's
+robot checks included (`lab_description.serviceability`). Same seed, same layout (Python's
 `random.Random`, no global state); the result is the world file's mapping, ready for YAML.
 
 Drawn per layout: 2 to 6 stations anywhere on the floor at any heading, the dock anywhere; per
@@ -28,8 +28,7 @@ import random
 from dataclasses import dataclass
 from typing import Any
 
-from tiago_sim.inspection.poi_paths import plan_poi_paths
-from tiago_sim.lab.serviceability import (
+from lab_description.serviceability import (
     BASE_RADIUS,
     HOTEL_SWEEP_RADIUS,
     TURN_MARGIN,
@@ -38,8 +37,9 @@ from tiago_sim.lab.serviceability import (
     bench_distances,
     drive_points,
 )
-from tiago_sim.lab.world import Pose2D, Station, World, WorldError, station_from_raw, world_from_raw
-from tiago_sim.lab.world_schema import MARKER_DICTIONARY_SIZE, MIRROR_AMBIGUOUS_MARKER_IDS
+from lab_description.world import Pose2D, Station, World, WorldError, station_from_raw, world_from_raw
+from lab_description.world_schema import MARKER_DICTIONARY_SIZE, MIRROR_AMBIGUOUS_MARKER_IDS
+from tiago_sim.inspection.poi_paths import plan_poi_paths
 from tiago_sim.layouts.station_draw import LABWARE_TYPES, RANGES, draw_station
 from tiago_sim.navigation.planner import PlanningError
 

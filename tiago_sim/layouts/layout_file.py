@@ -10,7 +10,7 @@ from pathlib import Path
 
 import yaml
 
-from tiago_sim.lab.world_schema import SCHEMA_FILE
+from lab_description.world_schema import SCHEMA_FILE
 from tiago_sim.layouts.furnish import furnish
 from tiago_sim.layouts.generator import generate_layout
 

@@ -1,7 +1,7 @@
 """One random station in its table frame, and the ranges every random layout is drawn from.
 
 Why these ranges: each is the schema's range narrowed to what the TIAGo++ serves, measured with
-the robot model (pinocchio IK, right arm top-down, torso free; `tiago_sim.lab.serviceability`):
+the robot model (pinocchio IK, right arm top-down, torso free; `lab_description.serviceability`):
 from a working pose 0.45 to 0.55 m in front of the nests, both the grasp and the approach 0.12 m
 above it are reachable for nests 0.55 to 0.80 m above the floor and 0 to 0.45 m to the right of the
 base (0.85 m: none; the approach would need the torso above its 0.35 m). So the nest row, at most
@@ -14,8 +14,8 @@ from __future__ import annotations
 import random
 from typing import Any
 
-from tiago_sim.lab.serviceability import WORKING_CLEARANCE
-from tiago_sim.robot import robot_model as rm
+from lab_description.serviceability import WORKING_CLEARANCE
+from tiago_description import robot_model as rm
 
 RANGES: dict[str, Any] = {
     "stations": (2, 6),

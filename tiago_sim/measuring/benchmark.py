@@ -33,7 +33,7 @@ TARGET_REALTIME_FACTOR = 10.0
 
 _NO_GOAL = {"starting", "done", "result"}  # task phases during which no robot goal runs
 _GOAL_LINE = re.compile(
-    r"tiago_sim\.sim_node\.action_servers: (/\w+) \S+: "
+    r"tiago_skills\.action_servers: (/\w+) \S+: "
     r"sim ([\d.]+) \.\. ([\d.]+) s, ([\d.-]+) s of it with no motion"
 )
 
@@ -85,9 +85,9 @@ def main(argv: list[str] | None = None) -> int:
     from rclpy.qos import QoSProfile, ReliabilityPolicy
     from rosgraph_msgs.msg import Clock
 
+    from lab_description.world import DEFAULT_WORLD, load_world
     from labware_model.holders import Nest
-    from tiago_sim import transforms as tf
-    from tiago_sim.lab.world import DEFAULT_WORLD, load_world
+    from tiago_description import transforms as tf
 
     world = load_world(args.world or DEFAULT_WORLD)
     plate = next(
@@ -96,7 +96,7 @@ def main(argv: list[str] | None = None) -> int:
     world_args = ["--world", str(args.world or DEFAULT_WORLD)]
     log_dir = Path(tempfile.mkdtemp(prefix="tiago_benchmark_"))
     sim = _start(
-        "tiago_sim.sim_node", [*world_args, "--seed", str(args.seed), "--log-level", "INFO"], log_dir
+        "tiago_twin", [*world_args, "--seed", str(args.seed), "--log-level", "INFO"], log_dir
     )
     sequencer = _start("tiago_sim.sequencer", world_args, log_dir)
     rclpy.init()
@@ -205,9 +205,9 @@ def _marker_errors(log_path: Path, world: Any, truth: dict[str, Any], np: Any, t
     """
     sightings: list[list[Any]] = []  # [station, T_base_marker seen, taken before the approach]
     for line in log_path.read_text().splitlines():
-        if "tiago_sim.sim_node.base_alignment: aligning at " in line and sightings:
+        if "tiago_skills.base_alignment: aligning at " in line and sightings:
             sightings[-1][2] = True
-        elif "tiago_sim.sim_node.marker_motion: marker" in line:
+        elif "tiago_skills.marker_motion: marker" in line:
             station = world.station(line.split(" of ", 1)[1].split()[0])
             position, quaternion = (
                 np.array([float(v) for v in part.split("]")[0].split()]) for part in line.split("[")[1:3]

@@ -39,10 +39,10 @@ from typing import Any
 
 import numpy as np
 
-from tiago_sim import transforms as tf
-from tiago_sim.lab.world import Pose2D, Station, World
+from lab_description.world import Pose2D, Station, World
+from tiago_description import robot_model
+from tiago_description import transforms as tf
 from tiago_sim.measuring.camera_noise import noisy_camera
-from tiago_sim.robot import robot_model
 
 log = logging.getLogger(__name__)
 

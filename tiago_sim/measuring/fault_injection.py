@@ -15,9 +15,9 @@ from typing import Any
 
 import pybullet as p
 
+from lab_description.world import World
 from labware_model.holders import Nest
-from tiago_sim.lab.world import World
-from tiago_sim.transforms import make_transform, to_pose
+from tiago_description.transforms import make_transform, to_pose
 
 log = logging.getLogger(__name__)
 

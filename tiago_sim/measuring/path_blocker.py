@@ -26,9 +26,9 @@ from typing import Any
 
 import pybullet as p
 
+from tiago_description.robot_model import BASE_RADIUS
 from tiago_sim.measuring.fault_injection import DRIVING_SPEED_M_S
 from tiago_sim.navigation.planner import Plan
-from tiago_sim.robot.robot_model import BASE_RADIUS
 
 log = logging.getLogger(__name__)
 

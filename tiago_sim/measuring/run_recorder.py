@@ -1,8 +1,9 @@
 """Pictures of one run, written by the sim node: overview frames and head-camera frames.
 
 Why in the sim process: only it owns PyBullet, so it renders a fixed overview camera every few
-simulated seconds and keeps every head-camera image the robot's perception used, with the
-station marker it finds outlined (the same detector the robot runs, on the same pixels).
+simulated seconds and keeps every head-camera image the robot's perception used, marked by the
+`annotate` function it is given (the start-up outlines the station marker with the detector the
+robot runs, on the same pixels; the simulator itself knows no detector).
 Frames go to ``<dir>/overview_NNNN.png`` and ``<dir>/head_NNNN.png``; the bench report turns
 them into a strip and a GIF. Lives on the sim thread (it wraps the Simulation's methods).
 """
@@ -10,6 +11,7 @@ them into a strip and a GIF. Lives on the sim thread (it wraps the Simulation's 
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -17,9 +19,8 @@ from typing import Any
 import cv2
 import numpy as np
 
-from tiago_sim.lab.world import World
-from tiago_sim.perception.aruco import detect_marker, draw_detection
-from tiago_sim.perception.camera import CameraIntrinsics, optical_frame_looking_at, render_rgbd
+from lab_description.world import World
+from tiago_sim.physics.camera import CameraIntrinsics, optical_frame_looking_at, render_rgbd
 
 log = logging.getLogger(__name__)
 
@@ -42,9 +43,16 @@ def overview_camera_pose(world: World) -> np.ndarray:
 class RunRecorder:
     """Wraps a Simulation's `step` and `render_head_camera` to save frames to a directory."""
 
-    def __init__(self, sim: Any, world: World, directory: Path) -> None:
+    def __init__(
+        self,
+        sim: Any,
+        world: World,
+        directory: Path,
+        annotate: Callable[[np.ndarray, np.ndarray, CameraIntrinsics], np.ndarray] | None = None,
+    ) -> None:
         self.sim = sim
         self.world = world
+        self.annotate = annotate  # a head frame (rgb, depth, intrinsics) to the picture saved
         self.directory = directory
         directory.mkdir(parents=True, exist_ok=True)
         self.T_world_overview = overview_camera_pose(world)
@@ -72,12 +80,7 @@ class RunRecorder:
 
     def render_head_camera(self, *args: Any, **kwargs: Any) -> tuple[np.ndarray, np.ndarray, Any]:
         rgb, depth, intrinsics = self._render_head(*args, **kwargs)
-        canvas = rgb
-        for station in self.world.stations:
-            observation = detect_marker(rgb, intrinsics, station.marker_id, station.marker_size, depth)
-            if observation is not None:
-                canvas = draw_detection(rgb, observation, intrinsics)
-                break
+        canvas = rgb if self.annotate is None else self.annotate(rgb, depth, intrinsics)
         self.head_count += 1
         self._write(f"head_{self.head_count:04d}.png", canvas)
         return rgb, depth, intrinsics

@@ -18,8 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tiago_description.robot_model import BASE_RADIUS
 from tiago_sim.navigation.occupancy_map import Footprint, OccupancyMap
-from tiago_sim.robot.robot_model import BASE_RADIUS
 
 EXPLAINED_M = 0.15
 """A beam ending closer than this to a mapped obstacle hit the map (the localisation map's own

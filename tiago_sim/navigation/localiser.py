@@ -22,9 +22,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tiago_description.transforms import Planar, compose_planar, invert_planar
 from tiago_sim.navigation.likelihood_field import LikelihoodField
 from tiago_sim.navigation.scan_matcher import ScanMatch, match_scan
-from tiago_sim.transforms import Planar, compose_planar, invert_planar
 
 log = logging.getLogger(__name__)
 

@@ -13,8 +13,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from tiago_sim.lab.world import MARKER_BOARD_SCALE, World
-from tiago_sim.robot.robot_model import BASE_RADIUS
+from lab_description.world import MARKER_BOARD_SCALE, World
+from tiago_description.robot_model import BASE_RADIUS
 
 DEFAULT_RESOLUTION = 0.05  # m per cell (the ROS 2 navigation stack's usual resolution)
 WALL_THICKNESS = 0.10  # m: the floor's edge is a wall this thick, inside the floor

@@ -17,10 +17,10 @@ import time
 
 import numpy as np
 
-from tiago_sim.lab.world import load_world
+from lab_description.world import load_world
 from tiago_sim.navigation.planner import PlanningError, world_planner
 
-BENCH_IN_THE_WAY = "tiago_sim/worlds/bench_in_the_way.yaml"
+BENCH_IN_THE_WAY = "lab_description/worlds/bench_in_the_way.yaml"
 
 
 def measure(world_file: str, plans: int, seed: int) -> dict[str, float]:

@@ -17,7 +17,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
-from tiago_sim.lab.world import DEFAULT_WORLD, load_world
+from lab_description.world import DEFAULT_WORLD, load_world
 from tiago_sim.navigation.planner import (
     INFLATION_RADIUS_M,
     ROBOT_RADIUS_M,

@@ -28,10 +28,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tiago_sim.lab.world import World
+from lab_description.world import World
+from tiago_description.hotel_model import hotel_sweep_radius
+from tiago_description.robot_model import BASE_RADIUS
 from tiago_sim.navigation.occupancy_map import OccupancyMap, build_map
-from tiago_sim.robot.hotel_model import hotel_sweep_radius
-from tiago_sim.robot.robot_model import BASE_RADIUS
 
 ARM_SWEEP_RADIUS_M = 0.48
 """The folded arms' farthest point from the base centre in the travel pose (Travel/Tuck, torso at

@@ -16,8 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tiago_description.transforms import Planar
 from tiago_sim.navigation.likelihood_field import LikelihoodField
-from tiago_sim.transforms import Planar
 
 HUBER_M = 0.03  # residuals below it count fully (two sigma of the laser's range noise)
 OUTLIER_M = 0.25  # first pass: farther from any mapped surface is not on the map

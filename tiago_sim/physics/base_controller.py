@@ -14,12 +14,12 @@ from collections.abc import Callable
 
 import numpy as np
 
-from tiago_sim.lab.world import Pose2D
+from lab_description.world import Pose2D
+from tiago_description import robot_model as rm
+from tiago_description.transforms import compose_planar as compose
+from tiago_description.transforms import invert_planar as invert
 from tiago_sim.physics.motion import CANCELED, Motion, SequenceMotion
 from tiago_sim.physics.robot_body import RobotBody
-from tiago_sim.robot import robot_model as rm
-from tiago_sim.transforms import compose_planar as compose
-from tiago_sim.transforms import invert_planar as invert
 
 POSITION_TOLERANCE = 0.01  # m
 YAW_TOLERANCE = 0.01  # rad
@@ -329,3 +329,31 @@ def docking_motion(
         ("docking", back_onto_dock, 0.3, docking_s),
     ]
     return SequenceMotion("dock", stages, frozenset({"base"}))
+
+
+class VelocityMotion(Motion):
+    """The base at a commanded twist for a while, as a velocity command on /cmd_vel drives it:
+    accelerating within the base's limits, then braking to a stand at the end or on a cancel."""
+
+    def __init__(self, base: DiffDriveBase, linear: float, angular: float, duration_s: float) -> None:
+        super().__init__("velocity", frozenset({"base"}))
+        self.base = base
+        self.linear, self.angular = linear, angular
+        self.duration_s = max(duration_s, 0.0)
+        self.phase = "driving"
+        self.remaining_s = self.duration_s
+
+    def tick(self, dt: float) -> None:
+        braking = self.cancel_requested or self.elapsed_s >= self.duration_s
+        if braking:
+            self.base.command(0.0, 0.0)
+            self.phase = "stopping"
+            if self.base.stopped():
+                if self.cancel_requested:
+                    self.finish(False, CANCELED, "canceled")
+                else:
+                    self.finish(True)
+            return
+        self.base.command(self.linear, self.angular)
+        self.progress = min(self.elapsed_s / max(self.duration_s, 1e-9), 1.0)
+        self.remaining_s = self.duration_s - self.elapsed_s

@@ -31,9 +31,9 @@ from dataclasses import dataclass
 import numpy as np
 import pybullet as p
 
+from tiago_description import robot_model as rm
 from tiago_sim.physics import plane_caster
 from tiago_sim.physics.robot_body import ROBOT_COLLISION_GROUP, RobotBody
-from tiago_sim.robot import robot_model as rm
 
 LASER_FRAME = "base_laser_link"
 LASER_STREAM = 0x1A5E  # second seed word of the laser's noise

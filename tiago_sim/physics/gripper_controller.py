@@ -21,10 +21,10 @@ import logging
 
 import pybullet as p
 
+from tiago_description import robot_model as rm
 from tiago_sim.physics.grip_load import GripLoad, GripLoadMonitor
 from tiago_sim.physics.motion import CANCELED, Motion
 from tiago_sim.physics.robot_body import RobotBody
-from tiago_sim.robot import robot_model as rm
 
 log = logging.getLogger(__name__)
 

@@ -14,10 +14,10 @@ from __future__ import annotations
 
 import math
 
+from tiago_description import robot_model as rm
 from tiago_sim.navigation.planner import Plan
 from tiago_sim.physics.base_controller import DiffDriveBase, DriveMotion, drive_duration_s, wrap_angle
 from tiago_sim.physics.motion import SequenceMotion
-from tiago_sim.robot import robot_model as rm
 
 TURN_WEIGHT_M = 0.1
 """Progress weight of a segment beyond its length (m): a turn in place is progress too."""

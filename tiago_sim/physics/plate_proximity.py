@@ -10,9 +10,9 @@ from __future__ import annotations
 import numpy as np
 import pybullet as p
 
+from tiago_description import robot_model as rm
 from tiago_sim.physics.gripper_controller import Gripper
 from tiago_sim.physics.robot_body import RobotBody
-from tiago_sim.robot import robot_model as rm
 
 STEP_REVIEW_PERIOD = 0.05  # s of sim time between proximity checks (tool <= 1.5 m/s: 7.5 cm)
 # A contact may start soon when two things are closer than this margin plus twice the distance the

@@ -15,10 +15,10 @@ from typing import Any
 import numpy as np
 import pybullet as p
 
+from lab_description.world import World
 from labware_model.holders import FLOOR, GRIPPER, UNKNOWN, HotelSlot, Location, Nest, location_text
 from labware_model.readings import HotelSlotReading, NestReading, PlacementCheck
-from tiago_sim import transforms as tf
-from tiago_sim.lab.world import World
+from tiago_description import transforms as tf
 from tiago_sim.physics.identity_readers import IdentityReaders
 from tiago_sim.physics.robot_body import RobotBody
 from tiago_sim.physics.scene import plate_bottom_pose

@@ -23,8 +23,8 @@ import numpy as np
 import pinocchio as pin
 import pybullet as p
 
-from tiago_sim import transforms as tf
-from tiago_sim.robot import robot_model
+from tiago_description import robot_model
+from tiago_description import transforms as tf
 
 BASE_CONSTRAINT_FORCE = 1e5
 ARM_POSITION_GAIN = 0.3

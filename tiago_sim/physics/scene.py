@@ -16,15 +16,15 @@ from dataclasses import dataclass, field
 import numpy as np
 import pybullet as p
 
+from lab_description.world import MARKER_BOARD_SCALE, Obstacle, Station, World
 from labware_model.holders import HotelSlot, Nest
 from labware_model.labware import LabwareType
-from tiago_sim import transforms as tf
-from tiago_sim.lab.world import MARKER_BOARD_SCALE, Obstacle, Station, World
+from tiago_description import transforms as tf
+from tiago_description.hotel_model import corner_ramp_boxes
+from tiago_description.robot_model import BASE_RADIUS
 from tiago_sim.navigation.occupancy_map import DOCK_GAP, DOCK_SIZE, WALL_THICKNESS
-from tiago_sim.perception.marker_asset import marker_visual
 from tiago_sim.physics.gridded_box import GRID_CELL, gridded_box_visual
-from tiago_sim.robot.hotel_model import corner_ramp_boxes
-from tiago_sim.robot.robot_model import BASE_RADIUS
+from tiago_sim.physics.marker_asset import marker_visual
 
 log = logging.getLogger(__name__)
 

@@ -38,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from labware_model.labware import LabwareType
-from tiago_sim import transforms as tf
+from tiago_description import transforms as tf
 from tiago_sim.physics.scene import NEST_LEAD_IN_SLOPE
 
 # What contacts let a resting plate stray from lying flat in the pocket, measured on plates settled

@@ -16,15 +16,17 @@ import time
 import numpy as np
 import pybullet as p
 
+from lab_description.world import World
 from labware_model.holders import Nest
 from labware_model.readings import HotelSlotReading, NestReading, PlacementCheck
-from tiago_sim.lab.world import World
+from robot_port.types import CameraIntrinsics, JointTrajectory, joint_group
+from tiago_description import robot_model as rm
 from tiago_sim.navigation.blockage import UnmappedObstacles
 from tiago_sim.navigation.planner import Plan
-from tiago_sim.perception.camera import CameraIntrinsics, render_rgbd
 from tiago_sim.physics.arm_controller import JointTrajectoryMotion
-from tiago_sim.physics.base_controller import DiffDriveBase, DriveMotion, docking_motion
+from tiago_sim.physics.base_controller import DiffDriveBase, DriveMotion, VelocityMotion, docking_motion
 from tiago_sim.physics.base_laser import BaseLaser, LaserSpec, laser_rng
+from tiago_sim.physics.camera import render_rgbd
 from tiago_sim.physics.collision_watch import COLLISION, CollisionWatch
 from tiago_sim.physics.gripper_controller import HOLDER_FRICTION, Gripper, GripperMotion
 from tiago_sim.physics.guarded_path import GuardedPathMotion
@@ -37,9 +39,6 @@ from tiago_sim.physics.robot_body import RobotBody
 from tiago_sim.physics.scene import build_scene
 from tiago_sim.physics.sim_clock import SimClock
 from tiago_sim.physics.step_ledger import StepLedger
-from tiago_sim.physics.tool_path import STRAIGHT_STEP, plan_tool_path
-from tiago_sim.robot import robot_model as rm
-from tiago_sim.robot.kinematics import RobotKinematics
 
 log = logging.getLogger(__name__)
 
@@ -74,7 +73,6 @@ FREE_MOTION_CONSTRAINT_ERP = 0.5
 DRIVE_CONSTRAINT_ERP = 0.66  # the same lag at 1/30 s: 17.2 ms at 0.27 and 0.53 m/s
 LOADED_TURN_RATE = 0.05  # rad/s: above it, with an unclamped plate in the hotel, steps stay short
 DOCK_SENSOR_RANGE = 0.004  # m: the charging contacts close within this distance
-TOOL_SPEED = 0.08  # m/s along straight tool moves unless the caller asks otherwise
 # The start posture: arms folded (as in "Travel"), head level; not PAL's `home` (other values).
 START_ARM = (0.2, -1.1, -0.2, 1.94, -1.57, 1.37, 0.0)
 START_TORSO = 0.15
@@ -118,7 +116,6 @@ class Simulation:
         self.hotel_clamp = HotelClamp(self.robot, self.scene.plates)
         self._clamped_for_drive = False
         self.plate_proximity = PlateProximity(c, self.robot, self.scene.plates, self.grippers)
-        self.kinematics = RobotKinematics()
         # The head camera's true mount against the model's head_front_camera_rgb_optical_frame (a hand-eye
         # calibration error; identity unless tiago_sim.measuring.disturbances sets one).
         self.T_camera_mount_error = np.eye(4)
@@ -322,6 +319,12 @@ class Simulation:
         motion = path_motion(self.base, plan, yaw, speed=speed)
         return self._start(motion if watch is None else GuardedPathMotion(self, motion, plan, watch))
 
+    def command_velocity(self, linear: float, angular: float, duration_s: float) -> Motion:
+        """The base at a twist (m/s, rad/s) for ``duration_s``, then braking to a stand."""
+        if self.is_docked():
+            return FailedMotion("velocity", "DOCKED", "undock first")
+        return self._start(VelocityMotion(self.base, linear, angular, duration_s))
+
     def dock(self) -> Motion:
         if self.is_docked():
             return CompletedMotion("dock", "already docked")
@@ -341,52 +344,33 @@ class Simulation:
         return self._start(motion)
 
     def move_joints(self, targets: dict[str, float], speed_scale: float = 1.0) -> Motion:
-        unknown = [n for n in targets if n not in self.robot.joint_index]
-        if unknown or not targets:
-            return FailedMotion(
-                "move_joints", "BAD_GOAL", f"unknown joints {unknown}" if unknown else "no targets"
-            )
-        resources = frozenset(self._joint_resource(n) for n in targets)
-        return self._start(
-            JointTrajectoryMotion(self.robot, [dict(targets)], speed_scale, resources=resources)
+        """To joint targets in one segment (a one-point trajectory)."""
+        return self.execute_trajectory(JointTrajectory((dict(targets),), speed_scale))
+
+    def execute_trajectory(self, trajectory: JointTrajectory) -> Motion:
+        """The joint-trajectory controllers of the trajectory's groups follow it together (the
+        timing is the controllers', see robot_port.types.JointTrajectory)."""
+        names = trajectory.joint_names
+        unknown = [n for n in names if n not in self.robot.joint_index]
+        if unknown or not names:
+            why = f"unknown joints {unknown}" if unknown else "no targets"
+            return FailedMotion(trajectory.name, "BAD_GOAL", why)
+        motion = JointTrajectoryMotion(
+            self.robot,
+            list(trajectory.points),
+            trajectory.speed_scale,
+            name=trajectory.name,
+            min_segment_s=trajectory.min_segment_s,
+            resources=frozenset(self._joint_resource(n) for n in names),
         )
+        return self._start(motion)
 
     @staticmethod
     def _joint_resource(name: str) -> str:
-        for side in rm.ARM_SIDES:
-            if name.startswith(f"arm_{side}_"):
-                return f"arm_{side}"
-            if name.startswith(f"gripper_{side}_"):
-                return f"gripper_{side}"
-        return name.split("_")[0]  # torso, head, wheel
-
-    def move_tool(
-        self,
-        arm: str,
-        T_base_grasp: np.ndarray,
-        straight_line: bool = True,
-        tool_speed: float = TOOL_SPEED,
-        use_torso: bool = True,
-    ) -> Motion:
-        """Grasping frame of ``arm`` to a pose in base_footprint, via IK waypoints when straight.
-
-        ``tool_speed`` (m/s) caps the speed along a straight line; the joint limits cap it too.
-        ``use_torso`` False keeps the torso still (it lifts at only 0.07 m/s and would set the pace).
-        """
-        if arm not in rm.ARM_SIDES:
-            return FailedMotion("move_tool", "BAD_GOAL", f"unknown arm {arm!r}")
-        planned = plan_tool_path(
-            self.kinematics, self.rng, arm, self.joint_positions(), T_base_grasp, straight_line, use_torso
-        )
-        if isinstance(planned, str):
-            return FailedMotion("move_tool", "IK_FAILED", planned)
-        solutions = planned
-        segment_s = STRAIGHT_STEP / max(tool_speed, 1e-3) if straight_line else 0.0
-        resources = frozenset({f"arm_{arm}", "torso"})
-        motion = JointTrajectoryMotion(
-            self.robot, solutions, 1.0, name="move_tool", min_segment_s=segment_s, resources=resources
-        )
-        return self._start(motion)
+        try:
+            return joint_group(name)
+        except ValueError:
+            return name.split("_")[0]  # wheels, casters
 
     def gripper(self, arm: str, close: bool) -> Motion:
         if arm not in rm.ARM_SIDES:

@@ -1,4 +1,5 @@
-"""The ROS 2 node that owns the simulation: action servers, publishers, the robot's skills.
+"""The simulator's ROS 2 side: the sim thread that owns PyBullet, the hardware port on it
+(`hardware`), the sensor topics, the navigation stand-in and localisation, fault injection.
 
-Run it with `python -m tiago_sim.sim_node --world FILE` (see `node`).
+Nothing here is robot software: `python -m tiago_twin --world FILE` starts it with the skills.
 """

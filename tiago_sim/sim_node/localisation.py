@@ -23,7 +23,7 @@ import time
 from dataclasses import dataclass
 from typing import Any
 
-from tiago_sim.lab.world import World
+from lab_description.world import World
 from tiago_sim.navigation.likelihood_field import LikelihoodField
 from tiago_sim.navigation.localiser import LocalisationUpdate, Localiser
 from tiago_sim.navigation.occupancy_map import build_map

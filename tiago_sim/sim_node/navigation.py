@@ -1,7 +1,9 @@
-"""Navigation in the sim node: the map on /map, the planned path on /plan, and drives along it.
+"""The navigation stand-in: the map on /map, the planned path on /plan, and drives along it.
 
-Why here and not on the sim thread: planning is pure (navigation.planner) and takes milliseconds
-to tens of them; run on the goal's executor thread it never stalls physics. The map is the one the
+Why on the simulator's side: on a TIAGo++ the navigation stack (Nav2) plans, localises and drives;
+the robot's skills only send it goals through the hardware port. Why on a thread of its own and
+not on the sim thread: planning is pure (navigation.planner) and takes milliseconds to tens of
+them; off the sim thread it never stalls physics. The map is the one the
 robot believes (the world file as the robot knows it, not the disturbed truth), published once and
 latched (transient local), as map_server does; the planning map, inflated by the robot's turning
 circle, goes out the same way on /global_costmap/costmap. Things not on the map: the drive is
@@ -9,12 +11,13 @@ watched by the base laser (physics.guarded_path); stopped short of an obstacle, 
 what it saw on a local copy of the map (this goal only; /map stays the static map) and plans again
 from its pose estimate; with no way round it waits and re-tries (a fresh scan forgets marks it
 now sees through) for BLOCKED_TIMEOUT_S of simulated time. Frames: ``map`` (the world frame; the
-base pose estimate is in it). Lives on: rclpy executor threads (goals, one at a time).
+base pose estimate is in it). Lives on: a thread per goal (one goal at a time).
 """
 
 from __future__ import annotations
 
 import logging
+import threading
 import time
 from typing import Any
 
@@ -26,13 +29,13 @@ from nav_msgs.msg import OccupancyGrid, Path
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
-from tiago_sim.lab.world import World
+from lab_description.world import World
 from tiago_sim.navigation.blockage import UnmappedObstacles, marks, still_there
 from tiago_sim.navigation.occupancy_map import OccupancyMap
 from tiago_sim.navigation.planner import GlobalPlanner, Plan, PlanningError, world_planner
 from tiago_sim.physics.guarded_path import PATH_BLOCKED, scan_in_map
-from tiago_sim.sim_node.action_run import ActionAbort, ActionRun
 from tiago_sim.sim_node.publishers import stamp_of
+from tiago_sim.sim_node.sim_thread import SimThread
 
 log = logging.getLogger(__name__)
 
@@ -84,10 +87,56 @@ def path_message(plan: Plan, goal_yaw: float, start_yaw: float, stamp: Time) -> 
     return message
 
 
-class Navigation:
-    """The planner on the believed map, its topics, and the navigate drive."""
+class NavigationFailed(Exception):
+    """A navigation goal ends with a code of labware_interfaces/msg/ErrorCodes and a reason."""
 
-    def __init__(self, node: Node, world: World) -> None:
+    def __init__(self, code: str, message: str) -> None:
+        super().__init__(f"{code}: {message}")
+        self.code, self.message = code, message
+
+
+class NavigationGoal:
+    """One goal of the navigation stand-in, as the hardware port's Execution: it runs on a thread
+    of its own, beside the robot's software, as a navigation stack runs its goals."""
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+        self.progress = 0.0
+        self.phase = "planning"
+        self.remaining_s = 0.0
+        self.success = False
+        self.error_code = ""
+        self.message = ""
+        self.result: dict[str, Any] = {}
+        self.done = False
+        self._finished = threading.Event()
+        self._cancel = threading.Event()
+
+    @property
+    def cancel_requested(self) -> bool:
+        return self._cancel.is_set()
+
+    def cancel(self) -> None:
+        self._cancel.set()
+
+    def wait(self, timeout_s: float) -> bool:
+        self._finished.wait(timeout_s)
+        return self.done
+
+    def finish(self, success: bool, code: str = "", message: str = "") -> None:
+        self.success, self.error_code = success, "" if success else code
+        self.message = message or ("done" if success else code)
+        if success:
+            self.progress, self.remaining_s = 1.0, 0.0
+        self.done = True
+        self._finished.set()
+
+
+class Navigation:
+    """The planner on the believed map, its topics, and the drives along its plans."""
+
+    def __init__(self, node: Node, world: World, sim_thread: SimThread) -> None:
+        self.sim_thread = sim_thread
         self.planner = world_planner(world)
         self.static_map = self.planner.static_map
         latched = QoSProfile(
@@ -101,63 +150,84 @@ class Navigation:
         self.unmapped = UnmappedObstacles(self.static_map)
         self.last_plan: Plan | None = None
 
-    def drive(
-        self,
-        run: ActionRun,
-        goal: tuple[float, float, float],
-        goal_name: str,
-        *,
-        span: tuple[float, float] = (0.0, 1.0),
-        later_s: float = 0.0,
-    ) -> Any:
+    def navigate(self, goal: tuple[float, float, float], goal_name: str) -> NavigationGoal:
+        """Start a goal: plan from the pose estimate to `goal` and drive there (see `_drive`)."""
+        state = NavigationGoal("navigate")
+        threading.Thread(
+            target=self._run, args=(state, goal, goal_name), name="navigation", daemon=True
+        ).start()
+        return state
+
+    def _run(self, state: NavigationGoal, goal: tuple[float, float, float], goal_name: str) -> None:
+        try:
+            self._drive(state, goal, goal_name)
+        except NavigationFailed as failure:
+            state.finish(False, failure.code, failure.message)
+        except Exception as error:  # noqa: BLE001 - every goal ends with a result
+            log.exception("navigation to %s failed", goal_name)
+            state.finish(False, ErrorCodes.INTERNAL, f"internal error: {error}")
+        else:
+            state.finish(True)
+
+    def _drive(self, state: NavigationGoal, goal: tuple[float, float, float], goal_name: str) -> None:
         """Plan from the pose estimate to `goal`, publish the plan, follow it while the laser
         watches the corridor ahead; stopped short of an obstacle not on the map, mark it on a local
         copy of the map and plan again from where the robot stands. NAVIGATION_FAILED (naming why)
         when no path exists on the static map, or when obstacles not on the map leave none for
         BLOCKED_TIMEOUT_S of simulated time (re-tried every RETRY_PERIOD_S meanwhile)."""
+        sim_thread = self.sim_thread
         seen = np.zeros((0, 2))  # obstacles not on the map, seen during this goal (map frame)
         blocked_since: float | None = None
         while True:
-            start = run.sim(lambda sim: sim.pose_estimate())
+            start = sim_thread.run(lambda sim: sim.pose_estimate())
             try:
                 plan = self._plan(start, goal, seen)
             except PlanningError as error:
                 if not len(seen):
-                    raise ActionAbort(
+                    raise NavigationFailed(
                         ErrorCodes.NAVIGATION_FAILED, f"no path to {goal_name}: {error.reason}"
                     ) from None
-                now = run.sim_thread.sim_time
+                now = sim_thread.sim_time
                 blocked_since = now if blocked_since is None else blocked_since
                 what = f"an obstacle not on the map near {_near_text(seen, start)}"
                 if now - blocked_since >= BLOCKED_TIMEOUT_S:
-                    raise ActionAbort(
+                    raise NavigationFailed(
                         ErrorCodes.NAVIGATION_FAILED,
                         f"no path to {goal_name}: blocked by {what} for {BLOCKED_TIMEOUT_S:.0f} s "
                         f"(simulated): {error.reason}",
                     ) from None
                 left_s = BLOCKED_TIMEOUT_S - (now - blocked_since)
                 phase = f"waiting: the path to {goal_name} is blocked by {what}; re-trying for {left_s:.0f} s"
-                self._wait(run, phase, RETRY_PERIOD_S, span[0] + (span[1] - span[0]) * run_share(run, span))
-                scan = run.sim(scan_in_map)  # forget what is gone, add what is new
+                self._wait(state, phase, RETRY_PERIOD_S)
+                scan = sim_thread.run(scan_in_map)  # forget what is gone, add what is new
                 kept = still_there(seen, scan.points, scan.origin, scan.beam_rad)
                 seen = np.vstack([kept, self.unmapped.near_robot(scan.points, scan.pose[:2])])
                 continue
             blocked_since = None
             self.last_plan = plan
-            self.plan_pub.publish(path_message(plan, goal[2], start[2], stamp_of(run.sim_thread.sim_time)))
-            started: list[Any] = []
+            self.plan_pub.publish(path_message(plan, goal[2], start[2], stamp_of(sim_thread.sim_time)))
+            motion = sim_thread.run(
+                lambda sim, plan=plan: sim.follow_path(plan, goal[2], watch=self.unmapped)
+            )
+            self._follow(state, motion)
+            if motion.success:
+                return
+            if motion.error_code != PATH_BLOCKED:
+                raise NavigationFailed(motion.error_code or ErrorCodes.MOTION_FAILED, motion.message)
+            log.info("%s; planning again around it", motion.message)
+            seen = np.vstack([seen, motion.seen])
 
-            def follow(sim: Any, plan: Plan = plan, started: list[Any] = started) -> Any:
-                started.append(sim.follow_path(plan, goal[2], watch=self.unmapped))
-                return started[-1]
-
-            try:
-                return run.run_motion(follow, span=span, later_s=later_s)
-            except ActionAbort as abort:
-                if abort.code != PATH_BLOCKED:
-                    raise
-                log.info("%s; planning again around it", abort.message)
-                seen = np.vstack([seen, started[-1].seen])
+    def _follow(self, state: NavigationGoal, motion: Any) -> None:
+        """Wait for a drive, passing its progress on and a cancel request down to it."""
+        cancel_sent = False
+        while not motion.done:
+            if self.sim_thread.stopped:
+                raise NavigationFailed(ErrorCodes.INTERNAL, "simulation stopped")
+            if state.cancel_requested and not cancel_sent:
+                self.sim_thread.call(lambda _sim: motion.cancel())
+                cancel_sent = True
+            state.progress, state.phase, state.remaining_s = motion.progress, motion.phase, motion.remaining_s
+            motion.finished.wait(_WAIT_POLL_S)
 
     def _plan(
         self, start: tuple[float, float, float], goal: tuple[float, float, float], seen: np.ndarray
@@ -179,23 +249,16 @@ class Navigation:
         )
         return plan
 
-    @staticmethod
-    def _wait(run: ActionRun, phase: str, duration_s: float, progress: float) -> None:
-        """Stand for `duration_s` of simulated time, sending feedback that says why; cancellable."""
-        until = run.sim_thread.sim_time + duration_s
-        run.feedback(progress, phase, duration_s, force=True)
-        while run.sim_thread.sim_time < until:
-            if run.sim_thread.stopped:
-                raise ActionAbort(ErrorCodes.INTERNAL, "simulation stopped")
-            run.check_cancel()
-            run.feedback(progress, phase, until - run.sim_thread.sim_time)
+    def _wait(self, state: NavigationGoal, phase: str, duration_s: float) -> None:
+        """Stand for `duration_s` of simulated time, saying why; cancellable."""
+        until = self.sim_thread.sim_time + duration_s
+        while self.sim_thread.sim_time < until:
+            if self.sim_thread.stopped:
+                raise NavigationFailed(ErrorCodes.INTERNAL, "simulation stopped")
+            if state.cancel_requested:
+                raise NavigationFailed(ErrorCodes.CANCELED, "canceled on request")
+            state.phase, state.remaining_s = phase, until - self.sim_thread.sim_time
             time.sleep(_WAIT_POLL_S)
-
-
-def run_share(run: ActionRun, span: tuple[float, float]) -> float:
-    """The share of `span` the goal's progress has reached (0..1)."""
-    low, high = span
-    return min(max((run.progress - low) / max(high - low, 1e-9), 0.0), 1.0)
 
 
 def _near_text(points: np.ndarray, pose: tuple[float, float, float]) -> str:

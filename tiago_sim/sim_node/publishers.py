@@ -28,10 +28,10 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import CameraInfo, Image, JointState
 
 from labware_model.readings import HotelSlotReading, NestReading
+from tiago_description.transforms import wrap_angle
 from tiago_sim.sim_node.localisation import LocalisationLoop
 from tiago_sim.sim_node.localisation_topics import LocalisationTopics, LocalisationView, stamp_of
 from tiago_sim.sim_node.sim_thread import SimThread
-from tiago_sim.transforms import wrap_angle
 
 log = logging.getLogger(__name__)
 

@@ -21,6 +21,7 @@ import cv2
 import numpy as np
 import pytest
 
+from lab_description.world import load_world
 from sila_labware.benchmarks.campaign import (
     CAUSES,
     LEVEL_FLAGS,
@@ -30,7 +31,6 @@ from sila_labware.benchmarks.campaign import (
 )
 from sila_labware.deployment.demo import DemoReport
 from tests.helpers.sila_stack import free_port_base
-from tiago_sim.lab.world import load_world
 from tiago_sim.measuring import disturbances
 
 CLI = [sys.executable, "-m", "sila_labware.cli"]
@@ -201,7 +201,7 @@ def _robot_side_pids(domain_id: str) -> list[int]:
         except OSError:
             continue
         robot_side = name in ("sim_node", "sequencer")  # forked from the prewarmed fork server
-        robot_side |= b"tiago_sim.sim_node" in command or b"tiago_sim.sequencer" in command
+        robot_side |= b"tiago_twin" in command or b"tiago_sim.sequencer" in command
         if robot_side and f"ROS_DOMAIN_ID={domain_id}".encode() in environment:
             pids.append(int(entry.name))
     return pids

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import yaml
 
+from lab_description.world import load_world
 from sila_labware.benchmarks.campaign import (
     CampaignOptions,
     TrialOutcome,
@@ -21,11 +22,10 @@ from sila_labware.benchmarks.campaign import (
 from sila_labware.benchmarks.random_layouts import keep_failed_layouts
 from sila_labware.deployment.stack import DeploymentOptions
 from tests.sila_labware.benchmarks.test_bench import CLI, run_bench
-from tiago_sim.lab.world import load_world
 from tiago_sim.layouts.layout_file import furnished_yaml, layout_yaml
 
 SEED = 5150
-DEFAULT_WORLD = Path(__file__).resolve().parents[3] / "tiago_sim" / "worlds" / "default.yaml"
+DEFAULT_WORLD = Path(__file__).resolve().parents[3] / "lab_description" / "worlds" / "default.yaml"
 
 
 def test_each_worker_gets_its_own_ports_domain_and_ca_file_and_each_trial_its_layout(tmp_path: Path) -> None:

@@ -39,7 +39,7 @@ def test_robot_and_station_servers_attach_to_a_running_robot_side(tmp_path: Path
     robot_side = ProcessGroup(ros_environment(int(os.environ["ROS_DOMAIN_ID"])), tmp_path / "logs")
     servers: list[subprocess.Popen] = []
     try:
-        for name, module in (("sim_node", "tiago_sim.sim_node"), ("sequencer", "tiago_sim.sequencer")):
+        for name, module in (("sim_node", "tiago_twin"), ("sequencer", "tiago_sim.sequencer")):
             robot_side.start_python_module(name, module, ["--world", str(DEFAULT_WORLD)])
         port = free_port_base(2)
         servers.append(start_server("sila_labware.servers.robot_server", port, tmp_path / "robot-ca.pem"))

@@ -10,12 +10,12 @@ from pathlib import Path
 import pytest
 import yaml
 
+from lab_description.world import load_world
+from lab_description.world_schema import SCHEMA_FILE
+from tiago_description import hotel_model, robot_model
 from tiago_sim.inspection import world_picture
 from tiago_sim.inspection.poi_paths import plan_poi_paths
 from tiago_sim.inspection.world_check import check_world, main
-from tiago_sim.lab.world import load_world
-from tiago_sim.lab.world_schema import SCHEMA_FILE
-from tiago_sim.robot import hotel_model, robot_model
 
 WORLDS = sorted(SCHEMA_FILE.parent.glob("*.yaml"))
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"

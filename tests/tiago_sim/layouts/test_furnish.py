@@ -9,13 +9,13 @@ from pathlib import Path
 import pytest
 import yaml
 
+from lab_description.world import load_world, world_from_raw
+from lab_description.world_obstacles import KEEP_CLEAR_M
 from tiago_sim.inspection.poi_paths import plan_poi_paths
-from tiago_sim.lab.world import load_world, world_from_raw
-from tiago_sim.lab.world_obstacles import KEEP_CLEAR_M
 from tiago_sim.layouts.furnish import COUNT, furnish
 from tiago_sim.layouts.layout_file import furnished_yaml
 
-DEFAULT_WORLD = Path(__file__).resolve().parents[3] / "tiago_sim" / "worlds" / "default.yaml"
+DEFAULT_WORLD = Path(__file__).resolve().parents[3] / "lab_description" / "worlds" / "default.yaml"
 BASE = yaml.safe_load(DEFAULT_WORLD.read_text())
 SEEDS = range(6000, 6012)
 

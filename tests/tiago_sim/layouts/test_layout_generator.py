@@ -12,9 +12,9 @@ import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from lab_description.serviceability import bench_distance
+from lab_description.world import load_world
 from labware_model.holders import Nest
-from tiago_sim.lab.serviceability import bench_distance
-from tiago_sim.lab.world import load_world
 from tiago_sim.layouts.generator import (
     DOCK_BOX,
     DOCK_BOX_BEHIND,

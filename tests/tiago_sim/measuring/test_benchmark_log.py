@@ -1,7 +1,7 @@
 """The one-transfer benchmark reads the sim node's log: goal spans and marker sightings.
 
-Why: the log lines are written by tiago_sim.sim_node.action_servers and
-tiago_sim.sim_node.marker_motion; if their format drifts, the benchmark would silently time nothing
+Why: the log lines are written by tiago_skills.action_servers and
+tiago_skills.marker_motion; if their format drifts, the benchmark would silently time nothing
 or compare a sighting with the wrong ground truth. The lines below are copied in shape from a real
 run of the sim node.
 """
@@ -14,8 +14,8 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from tiago_sim import transforms as tf
-from tiago_sim.lab.world import DEFAULT_WORLD, load_world
+from lab_description.world import DEFAULT_WORLD, load_world
+from tiago_description import transforms as tf
 from tiago_sim.measuring import benchmark
 
 PREFIX = "2026-11-23 17:10:19,711 INFO "
@@ -31,12 +31,12 @@ def test_goal_spans_read_start_end_and_time_without_motion(tmp_path: Path) -> No
     log = _write(
         tmp_path,
         [
-            "tiago_sim.sim_node.action_servers: /undock done: sim 4.133 .. 6.833 s, 0.042 s of it with "
+            "tiago_skills.action_servers: /undock done: sim 4.133 .. 6.833 s, 0.042 s of it with "
             "no motion running",
-            "tiago_sim.sim_node.marker_motion: marker 3 of station_a at [ 0.8 -0.1  0.84 ] in base, "
+            "tiago_skills.marker_motion: marker 3 of station_a at [ 0.8 -0.1  0.84 ] in base, "
             "quaternion [0 0 0 1] "
             "(reprojection 0.09 px)",
-            "tiago_sim.sim_node.action_servers: /marker_motion MARKER_NOT_FOUND: sim 13.5 .. 18.7 s, "
+            "tiago_skills.action_servers: /marker_motion MARKER_NOT_FOUND: sim 13.5 .. 18.7 s, "
             "0.342 s of it with "
             "no motion running",
         ],
@@ -59,12 +59,12 @@ def test_only_sightings_from_where_the_base_stood_are_compared(
     seen[:3, 3] += (0.001, 0.0, 0.0)
     position = " ".join(f"{v:.4f}" for v in seen[:3, 3])
     quaternion = " ".join(f"{v:.5f}" for v in tf.matrix_to_quat(seen[:3, :3]))
-    sighting = f"tiago_sim.sim_node.marker_motion: marker {station.marker_id} of {station.name} at"
+    sighting = f"tiago_skills.marker_motion: marker {station.marker_id} of {station.name} at"
     log = _write(
         tmp_path,
         [
             f"{sighting} [ 0.9 -0.1 0.84 ] in base, quaternion [0.5 -0.5 0.5 -0.5] (reprojection 0.09 px)",
-            f"tiago_sim.sim_node.base_alignment: aligning at {station.name}: "
+            f"tiago_skills.base_alignment: aligning at {station.name}: "
             "working pose at x 0.218 y 0.002 m, "
             "yaw 0.2 deg from here",
             f"{sighting} [ {position} ] in base, quaternion [{quaternion}] (reprojection 0.10 px)",

@@ -16,16 +16,17 @@ import numpy as np
 import pybullet as p
 import pytest
 
-from tiago_sim import transforms as tf
-from tiago_sim.lab.world import load_world
+from lab_description.world import load_world
+from tests.helpers.tool_moves import KINEMATICS
+from tiago_description import robot_model as rm
+from tiago_description import transforms as tf
 from tiago_sim.measuring import disturbances
 from tiago_sim.measuring.camera_noise import depth_sigma, noisy_depth
-from tiago_sim.perception.aruco import detect_marker
-from tiago_sim.perception.camera import render_rgbd
 from tiago_sim.physics.arm_controller import SETTLE_TOLERANCE
+from tiago_sim.physics.camera import render_rgbd
 from tiago_sim.physics.simulation import Simulation
-from tiago_sim.robot import robot_model as rm
-from tiago_sim.sim_node.base_alignment import head_angles_towards
+from tiago_skills.base_alignment import head_angles_towards
+from tiago_skills.perception.aruco import detect_marker
 
 CAMERA_FRAME = "head_front_camera_rgb_optical_frame"
 STATION = "station_a"
@@ -47,7 +48,7 @@ def sim_at_marker() -> Iterator[Simulation]:
         sim.run(sim.undock())
         assert sim.run(sim.drive_to(goal.x, goal.y, goal.yaw)).success
         marker = (tf.invert(sim.robot.base_pose()) @ station.T_world_marker())[:3, 3]
-        head = head_angles_towards(sim.kinematics, sim.joint_positions(), marker)
+        head = head_angles_towards(KINEMATICS, sim.joint_positions(), marker)
         assert sim.run(sim.move_joints(head)).success
         yield sim
     finally:
@@ -66,7 +67,7 @@ def _true_base_camera(sim: Simulation) -> np.ndarray:
 
 def _believed_base_camera(sim: Simulation) -> np.ndarray:
     """What the robot software computes: FK of the joint readings in the nominal model."""
-    return sim.kinematics.forward(sim.joint_positions(), CAMERA_FRAME)
+    return KINEMATICS.forward(sim.joint_positions(), CAMERA_FRAME)
 
 
 def _pose_difference(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
@@ -154,9 +155,9 @@ def test_joint_offsets_shift_the_readings_and_the_poses_fk_gives(sim_at_marker):
     for name, target in arm.items():
         assert readings[name] == pytest.approx(target, abs=SETTLE_TOLERANCE)
     frame = "gripper_right_grasping_frame"
-    believed = sim.kinematics.forward(readings, frame)
+    believed = KINEMATICS.forward(readings, frame)
     true_tool = tf.invert(sim.robot.base_pose()) @ sim.robot.link_pose(frame)
-    from_true_joints = sim.kinematics.forward(
+    from_true_joints = KINEMATICS.forward(
         {name: value - drawn.joint_offsets.get(name, 0.0) for name, value in readings.items()}, frame
     )
     assert _pose_difference(true_tool, from_true_joints)[0] < 1e-4

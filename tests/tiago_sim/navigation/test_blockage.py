@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from tiago_sim.lab.world import DEFAULT_WORLD, load_world
+from lab_description.world import DEFAULT_WORLD, load_world
 from tiago_sim.navigation.blockage import (
     CORRIDOR_HALF_WIDTH_M,
     LOOKAHEAD_M,

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from tiago_sim.lab.world import DEFAULT_WORLD, load_world
+from lab_description.world import DEFAULT_WORLD, load_world
 from tiago_sim.navigation.occupancy_map import build_map
 
 BENCH_IN_THE_WAY = DEFAULT_WORLD.parent / "bench_in_the_way.yaml"

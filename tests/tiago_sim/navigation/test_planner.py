@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from tiago_sim.lab.world import DEFAULT_WORLD, load_world, world_from_raw
-from tiago_sim.lab.world_obstacles import KEEP_CLEAR_M
+from lab_description.world import DEFAULT_WORLD, load_world, world_from_raw
+from lab_description.world_obstacles import KEEP_CLEAR_M
 from tiago_sim.layouts.generator import generate_layout
 from tiago_sim.measuring.disturbances import DisturbanceLevels
 from tiago_sim.navigation.occupancy_map import Footprint, OccupancyMap, build_map

@@ -10,11 +10,11 @@ import math
 
 import numpy as np
 
+from tiago_description.transforms import compose_planar, invert_planar
 from tiago_sim.navigation.likelihood_field import LikelihoodField
 from tiago_sim.navigation.localiser import Localiser
 from tiago_sim.navigation.occupancy_map import Footprint, OccupancyMap
 from tiago_sim.navigation.scan_matcher import match_scan
-from tiago_sim.transforms import compose_planar, invert_planar
 
 RESOLUTION = 0.01
 TRUE_POSE = (1.0, 0.5, math.radians(20.0))

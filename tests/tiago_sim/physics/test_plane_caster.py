@@ -13,7 +13,7 @@ import numpy as np
 import pybullet as p
 import pytest
 
-from tiago_sim.lab.world import load_world
+from lab_description.world import load_world
 from tiago_sim.layouts.generator import layout_world
 from tiago_sim.physics import plane_caster
 from tiago_sim.physics.robot_body import ROBOT_COLLISION_GROUP

@@ -9,10 +9,10 @@ import numpy as np
 import pybullet as p
 import pytest
 
-from tiago_sim.lab.world import World, load_world
-from tiago_sim.lab.world_schema import SCHEMA_FILE
+from lab_description.world import World, load_world
+from lab_description.world_schema import SCHEMA_FILE
 from tiago_sim.layouts.generator import layout_world
-from tiago_sim.perception.camera import CameraIntrinsics, optical_frame_looking_at, render_rgbd
+from tiago_sim.physics.camera import CameraIntrinsics, optical_frame_looking_at, render_rgbd
 from tiago_sim.physics.simulation import Simulation
 
 EYE_HEIGHT = 1.25  # m: about the head camera's height over a POI

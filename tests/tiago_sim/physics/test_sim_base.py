@@ -7,11 +7,11 @@ import math
 import numpy as np
 import pytest
 
+from lab_description.world import load_world
 from tests.helpers.sim_steps import step_for
-from tiago_sim import transforms as tf
-from tiago_sim.lab.world import load_world
+from tiago_description import robot_model as rm
+from tiago_description import transforms as tf
 from tiago_sim.physics.simulation import Simulation
-from tiago_sim.robot import robot_model as rm
 
 
 def _drive_recording(sim: Simulation, motion) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pybullet as p
 
-from tiago_sim.lab.world import load_world
+from lab_description.world import load_world
 from tiago_sim.physics.simulation import Simulation
 
 

@@ -8,7 +8,7 @@ import math
 import pybullet as p
 import pytest
 
-from tiago_sim.lab.world import DEFAULT_WORLD, load_world
+from lab_description.world import DEFAULT_WORLD, load_world
 from tiago_sim.navigation.occupancy_map import build_map
 from tiago_sim.navigation.planner import ROBOT_RADIUS_M, GlobalPlanner
 from tiago_sim.physics.collision_watch import COLLISION, NEAR_MISS_PERIOD_S

@@ -12,10 +12,11 @@ import numpy as np
 import pybullet as p
 import pytest
 
+from lab_description.world import load_world
 from labware_model.holders import GRIPPER, HotelSlot, Nest
 from tests.helpers.sim_steps import step_for
+from tests.helpers.tool_moves import KINEMATICS, move_tool
 from tests.tiago_sim.physics.test_sim_pick_place import APPROACH, ARM, CARRY, PLATE, Script
-from tiago_sim.lab.world import load_world
 from tiago_sim.physics.grip_load import GripLoadMonitor
 from tiago_sim.physics.simulation import Simulation
 
@@ -27,8 +28,8 @@ def _grasp_at_station_a(grip_force_n: float) -> tuple[Simulation, Script, np.nda
     script.run(sim.undock(), "undock")
     script.drive("station_a_work")
     T_base_site = script.site_in_base("station_a", 1)
-    script.run(sim.move_tool(ARM, script.grasp(T_base_site, APPROACH), straight_line=False), "approach")
-    script.run(sim.move_tool(ARM, script.grasp(T_base_site)), "descend")
+    script.run(move_tool(sim, ARM, script.grasp(T_base_site, APPROACH), straight_line=False), "approach")
+    script.run(move_tool(sim, ARM, script.grasp(T_base_site)), "descend")
     closed = script.run(sim.gripper(ARM, close=True), "close")
     assert closed.holding  # friction holds the plate on the nest floor, whatever the force
     return sim, script, T_base_site
@@ -53,7 +54,7 @@ def test_a_weak_grip_lets_the_plate_slip_out_under_its_weight():
     sim, script, T_base_site = _grasp_at_station_a(1.5)
     try:
         gripper = sim.grippers[ARM]
-        lift = sim.run(sim.move_tool(ARM, script.grasp(T_base_site, CARRY)))
+        lift = sim.run(move_tool(sim, ARM, script.grasp(T_base_site, CARRY)))
         assert lift.success, lift.message
         step_for(sim, 1.0)
         assert gripper.slipped_id == PLATE and gripper.attached_id == ""
@@ -72,9 +73,9 @@ def test_at_the_real_force_the_plate_rides_through_lift_and_carry():
     sim, script, T_base_site = _grasp_at_station_a(16.0)
     try:
         gripper = sim.grippers[ARM]
-        script.run(sim.move_tool(ARM, script.grasp(T_base_site, CARRY)), "lift")
-        T_base_slot = sim.kinematics.forward(sim.joint_positions(), "hotel_slot_1")
-        script.run(sim.move_tool(ARM, script.grasp(T_base_slot, CARRY)), "carry to the hotel")
+        script.run(move_tool(sim, ARM, script.grasp(T_base_site, CARRY)), "lift")
+        T_base_slot = KINEMATICS.forward(sim.joint_positions(), "hotel_slot_1")
+        script.run(move_tool(sim, ARM, script.grasp(T_base_slot, CARRY)), "carry to the hotel")
         assert gripper.slipped_id == "" and gripper.attached_id == PLATE
         assert sim.check_placement(PLATE).location == GRIPPER
     finally:
@@ -87,9 +88,9 @@ def test_a_plate_pressed_into_the_nest_slips_in_the_fingers():
     sim, script, T_base_site = _grasp_at_station_a(16.0)
     try:
         gripper = sim.grippers[ARM]
-        script.run(sim.move_tool(ARM, script.grasp(T_base_site, 0.02)), "lift a little")
+        script.run(move_tool(sim, ARM, script.grasp(T_base_site, 0.02)), "lift a little")
         assert gripper.attached_id == PLATE
-        sim.run(sim.move_tool(ARM, script.grasp(T_base_site, -0.008), tool_speed=0.02))
+        sim.run(move_tool(sim, ARM, script.grasp(T_base_site, -0.008), tool_speed=0.02))
         assert gripper.slipped_id == PLATE, "the attach held a plate pressed into the nest floor"
         assert gripper.last_slip is not None
         assert gripper.last_slip.largest_push[2] > 0.0  # the load came from a contact, not from inertia
@@ -106,7 +107,7 @@ def test_the_hotel_clamp_opens_on_a_plate_something_falls_on():
         script.run(sim.undock(), "undock")
         script.drive("station_a_work")
         script.pick(script.site_in_base("station_a", 1))
-        T_base_slot = sim.kinematics.forward(sim.joint_positions(), "hotel_slot_1")
+        T_base_slot = KINEMATICS.forward(sim.joint_positions(), "hotel_slot_1")
         script.place(T_base_slot)
         assert sim.check_placement(PLATE).location == HotelSlot(1)
         drive = sim.drive_to(*sim.odometry()[:2], sim.odometry()[2] + 1.0)  # turn on the spot

@@ -3,10 +3,11 @@ their barcode reader read it; presence comes from the sensor, and physics still 
 
 from __future__ import annotations
 
+from lab_description.world import load_world
 from labware_model.holders import Nest
 from labware_model.readings import NestReading
+from tests.helpers.tool_moves import KINEMATICS, move_tool
 from tests.tiago_sim.physics.test_sim_pick_place import APPROACH, ARM, CARRY, PLATE, Script
-from tiago_sim.lab.world import load_world
 from tiago_sim.physics.identity_readers import IdentityReaders
 from tiago_sim.physics.simulation import Simulation
 
@@ -57,14 +58,14 @@ def test_unread_plates_are_present_without_an_id_and_physics_still_locates_them(
         script.run(sim.undock(), "undock")
         script.drive("station_a_work")
         T_base_site = script.site_in_base("station_a", 1)
-        script.run(sim.move_tool(ARM, script.grasp(T_base_site, APPROACH), straight_line=False), "approach")
-        script.run(sim.move_tool(ARM, script.grasp(T_base_site)), "descend")
+        script.run(move_tool(sim, ARM, script.grasp(T_base_site, APPROACH), straight_line=False), "approach")
+        script.run(move_tool(sim, ARM, script.grasp(T_base_site)), "descend")
         assert script.run(sim.gripper(ARM, close=True), "close").holding
-        script.run(sim.move_tool(ARM, script.grasp(T_base_site, CARRY)), "lift")
+        script.run(move_tool(sim, ARM, script.grasp(T_base_site, CARRY)), "lift")
         assert sim.grippers[ARM].attached_id == PLATE
         assert sim.held_labware(ARM) == ""  # the gripper's reader failed too
         assert sim.gripper_holds(ARM)  # but the fingers know they hold something
-        T_base_slot = sim.kinematics.forward(sim.joint_positions(), "hotel_slot_1")
+        T_base_slot = KINEMATICS.forward(sim.joint_positions(), "hotel_slot_1")
         script.place(T_base_slot)
         assert [reading.labware_id for reading in sim.hotel_readings()] == ["", ""]
         assert [reading.occupied for reading in sim.hotel_readings()] == [True, False]  # presence

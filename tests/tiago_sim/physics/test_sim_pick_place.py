@@ -13,15 +13,16 @@ import numpy as np
 import pybullet as p
 import pytest
 
+from lab_description.world import load_world
 from labware_model.holders import GRIPPER, HotelSlot, Nest
 from labware_model.readings import HotelSlotReading, NestReading
 from tests.helpers.sim_steps import step_for, step_lengths
-from tiago_sim import transforms as tf
-from tiago_sim.lab.world import load_world
+from tests.helpers.tool_moves import KINEMATICS, TOOL_SPEED, move_tool
+from tiago_description import robot_model as rm
+from tiago_description import transforms as tf
+from tiago_description.kinematics import top_down_grasp
 from tiago_sim.physics.plate_proximity import CONTACT_MARGIN, STEP_REVIEW_PERIOD
-from tiago_sim.physics.simulation import FREE_MOTION_STEP_RATIO, START_ARM, TOOL_SPEED, Simulation
-from tiago_sim.robot import robot_model as rm
-from tiago_sim.robot.kinematics import top_down_grasp
+from tiago_sim.physics.simulation import FREE_MOTION_STEP_RATIO, START_ARM, Simulation
 
 ARM = "right"
 APPROACH = 0.10
@@ -50,30 +51,28 @@ class Script:
         return tf.invert(self.sim.robot.base_pose()) @ self.sim.plate_bottom_pose(PLATE)
 
     def plate_in_grasp(self) -> np.ndarray:
-        T_base_grasp = self.sim.kinematics.forward(
-            self.sim.joint_positions(), f"gripper_{ARM}_grasping_frame"
-        )
+        T_base_grasp = KINEMATICS.forward(self.sim.joint_positions(), f"gripper_{ARM}_grasping_frame")
         return tf.invert(T_base_grasp) @ self.plate_in_base()
 
     def pick(self, T_base_site: np.ndarray) -> None:
-        self.run(self.sim.move_tool(ARM, self.grasp(T_base_site, APPROACH), straight_line=False), "approach")
-        self.run(self.sim.move_tool(ARM, self.grasp(T_base_site)), "descend")
+        self.run(move_tool(self.sim, ARM, self.grasp(T_base_site, APPROACH), straight_line=False), "approach")
+        self.run(move_tool(self.sim, ARM, self.grasp(T_base_site)), "descend")
         closed = self.run(self.sim.gripper(ARM, close=True), "close")
         assert closed.holding and closed.opening_m == pytest.approx(0.08548, abs=0.002)
         assert self.sim.held_labware(ARM) == PLATE
         before = self.plate_in_base()
-        self.run(self.sim.move_tool(ARM, self.grasp(T_base_site, CARRY)), "lift")
+        self.run(move_tool(self.sim, ARM, self.grasp(T_base_site, CARRY)), "lift")
         after = self.plate_in_base()
         self.slips_m.append(float(np.linalg.norm(after[:3, 3] - before[:3, 3] - [0, 0, CARRY])))
 
     def place(self, T_base_site: np.ndarray) -> None:
         T_before = self.plate_in_grasp()
-        self.run(self.sim.move_tool(ARM, self.grasp(T_base_site, CARRY)), "carry")
-        self.run(self.sim.move_tool(ARM, self.grasp(T_base_site, 0.002)), "lower")
+        self.run(move_tool(self.sim, ARM, self.grasp(T_base_site, CARRY)), "carry")
+        self.run(move_tool(self.sim, ARM, self.grasp(T_base_site, 0.002)), "lower")
         self.slips_m.append(float(np.linalg.norm(self.plate_in_grasp()[:3, 3] - T_before[:3, 3])))
         opened = self.run(self.sim.gripper(ARM, close=False), "open")
         assert not opened.holding and opened.opening_m > 0.095
-        self.run(self.sim.move_tool(ARM, self.grasp(T_base_site, CARRY)), "retreat")
+        self.run(move_tool(self.sim, ARM, self.grasp(T_base_site, CARRY)), "retreat")
         assert self.sim.held_labware(ARM) == ""
 
     def drive(self, poi: str) -> None:
@@ -98,7 +97,7 @@ def test_plate_goes_from_station_a_through_the_hotel_to_station_b():
         assert sim.check_placement(PLATE).location == GRIPPER
         assert sim.nest_readings()[0] == NestReading(Nest("station_a", 1), False, "")
 
-        T_base_slot = sim.kinematics.forward(sim.joint_positions(), "hotel_slot_1")
+        T_base_slot = KINEMATICS.forward(sim.joint_positions(), "hotel_slot_1")
         script.place(T_base_slot)
         assert sim.hotel_readings() == [
             HotelSlotReading(HotelSlot(1), PLATE, "sbs_microplate_96"),
@@ -133,7 +132,7 @@ def _tool_above_station_a(height: float) -> tuple[Simulation, Script, np.ndarray
         script.run(sim.undock(), "undock")
         script.drive("station_a_work")
         T_base_site = script.site_in_base("station_a", 1)
-        script.run(sim.move_tool(ARM, script.grasp(T_base_site, height), straight_line=False), "approach")
+        script.run(move_tool(sim, ARM, script.grasp(T_base_site, height), straight_line=False), "approach")
     except BaseException:
         sim.close()
         raise
@@ -144,14 +143,14 @@ def test_a_held_plate_takes_long_steps_in_free_space_and_short_ones_near_the_tab
     """The long step is where the simulation wins its speed; a held plate gets it only out of reach."""
     sim, script, T_base_site = _tool_above_station_a(APPROACH)
     try:
-        script.run(sim.move_tool(ARM, script.grasp(T_base_site)), "descend")
+        script.run(move_tool(sim, ARM, script.grasp(T_base_site)), "descend")
         script.run(sim.gripper(ARM, close=True), "close")
         long_step = sim.time_step * FREE_MOTION_STEP_RATIO
-        lift = sim.move_tool(ARM, script.grasp(T_base_site, CARRY))
+        lift = move_tool(sim, ARM, script.grasp(T_base_site, CARRY))
         up = step_lengths(sim, lift)
         assert lift.success, lift
         assert up[:20] == [sim.time_step] * 20 and up[-1] == long_step, up
-        lower = sim.move_tool(ARM, script.grasp(T_base_site, 0.002))
+        lower = move_tool(sim, ARM, script.grasp(T_base_site, 0.002))
         down = step_lengths(sim, lower)
         assert lower.success, lower
         assert down[0] == long_step and down[-20:] == [sim.time_step] * 20, down
@@ -171,7 +170,7 @@ def test_a_descent_onto_a_resting_plate_takes_short_steps_only_within_reach_of_i
     margin), short ones from there on: the contact physics never starts on a long step."""
     sim, script, T_base_site = _tool_above_station_a(CARRY)
     try:
-        descent = sim.move_tool(ARM, script.grasp(T_base_site))
+        descent = move_tool(sim, ARM, script.grasp(T_base_site))
         steps = []
         while not descent.done:
             gap = _gap_to_plate(sim)
@@ -268,12 +267,12 @@ def test_grasp_holds_a_plate_when_the_gripper_arrives_off_centre():
         script.drive("station_a_work")
         error = tf.from_xyz_rpy((0.002, -0.003, 0.0), (0.0, 0.0, np.radians(1.5)))
         T_base_site = script.site_in_base("station_a", 1) @ error
-        script.run(sim.move_tool(ARM, script.grasp(T_base_site, APPROACH), straight_line=False), "approach")
-        script.run(sim.move_tool(ARM, script.grasp(T_base_site)), "descend")
+        script.run(move_tool(sim, ARM, script.grasp(T_base_site, APPROACH), straight_line=False), "approach")
+        script.run(move_tool(sim, ARM, script.grasp(T_base_site)), "descend")
         closed = script.run(sim.gripper(ARM, close=True), "close")
         assert closed.holding and 0.085 < closed.opening_m < 0.090
         before = script.plate_in_grasp()
-        script.run(sim.move_tool(ARM, script.grasp(T_base_site, CARRY)), "lift")
+        script.run(move_tool(sim, ARM, script.grasp(T_base_site, CARRY)), "lift")
         assert sim.held_labware(ARM) == PLATE
         assert sim.check_placement(PLATE).location == GRIPPER
         assert np.linalg.norm(script.plate_in_grasp()[:3, 3] - before[:3, 3]) < 0.002
@@ -325,12 +324,12 @@ def test_a_held_plate_stays_where_the_hand_holds_it_and_is_let_go_of_where_it_ha
     hand between the measurement and the release and up to 1.2 mm more as the pads opened."""
     sim, script, T_base_site = _tool_above_station_a(APPROACH)
     try:
-        script.run(sim.move_tool(ARM, script.grasp(T_base_site)), "descend")
+        script.run(move_tool(sim, ARM, script.grasp(T_base_site)), "descend")
         script.run(sim.gripper(ARM, close=True), "close")
-        script.run(sim.move_tool(ARM, script.grasp(T_base_site, CARRY)), "lift")
-        script.run(sim.move_tool(ARM, script.grasp(T_base_site, APPROACH)), "over the nest")
+        script.run(move_tool(sim, ARM, script.grasp(T_base_site, CARRY)), "lift")
+        script.run(move_tool(sim, ARM, script.grasp(T_base_site, APPROACH)), "over the nest")
         measured = script.plate_in_grasp()  # where the measurement would see it
-        script.run(sim.move_tool(ARM, script.grasp(T_base_site, 0.006)), "lower")
+        script.run(move_tool(sim, ARM, script.grasp(T_base_site, 0.006)), "lower")
         lowered = script.plate_in_grasp()
         hanging = sim.plate_bottom_pose(PLATE)
         opening = sim.gripper(ARM, close=False)

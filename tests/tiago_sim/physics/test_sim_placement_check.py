@@ -17,10 +17,10 @@ import numpy as np
 import pybullet as p
 import pytest
 
+from lab_description.world import load_world
 from labware_model.holders import Nest
 from tests.helpers.sim_steps import step_for
-from tiago_sim import transforms as tf
-from tiago_sim.lab.world import load_world
+from tiago_description import transforms as tf
 from tiago_sim.physics.seating import (
     SEATED_EDGE_TOLERANCE,
     SEATED_HEIGHT_TOLERANCE,

@@ -10,9 +10,9 @@ from __future__ import annotations
 import numpy as np
 import pybullet as p
 
+from lab_description.world import load_world
 from tests.helpers.sim_steps import step_lengths
-from tiago_sim import transforms as tf
-from tiago_sim.lab.world import load_world
+from tiago_description import transforms as tf
 from tiago_sim.physics.simulation import DRIVE_STEP_RATIO, FREE_MOTION_STEP_RATIO, START_ARM, Simulation
 
 PLATE = "plate_001"

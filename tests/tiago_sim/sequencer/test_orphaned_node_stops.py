@@ -14,7 +14,7 @@ import sys
 import time
 from pathlib import Path
 
-WORLD = Path(__file__).resolve().parents[3] / "tiago_sim" / "worlds" / "default.yaml"
+WORLD = Path(__file__).resolve().parents[3] / "lab_description" / "worlds" / "default.yaml"
 PARENT = (
     "import subprocess, sys, time\n"
     "child = subprocess.Popen([sys.executable, '-m', 'tiago_sim.sequencer', '--world', sys.argv[1]])\n"

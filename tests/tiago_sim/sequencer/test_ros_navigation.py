@@ -1,6 +1,6 @@
 """Navigation through ROS only, in a lab with a third bench across the straight line from A to B.
 
-sim_node + sequencer run as real processes over DDS on tiago_sim/worlds/bench_in_the_way.yaml.
+sim_node + sequencer run as real processes over DDS on lab_description/worlds/bench_in_the_way.yaml.
 /map and /plan are read by plain rclpy subscribers with the QoS RViz's Map and Path displays use
 (the map latched: transient local). The transfer A -> B must go around bench_c with no contact
 (a contact fails the running goal with COLLISION); a POI moved into the bench is refused with
@@ -22,8 +22,8 @@ from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
 from rcl_interfaces.srv import SetParameters
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
+from lab_description.world import DEFAULT_WORLD, load_world
 from tests.helpers.ros_processes import RosCaller, running
-from tiago_sim.lab.world import DEFAULT_WORLD, load_world
 from tiago_sim.navigation.planner import INFLATION_RADIUS_M
 
 WORLD = DEFAULT_WORLD.parent / "bench_in_the_way.yaml"
@@ -35,7 +35,7 @@ TASK_TIMEOUT_S = 240.0
 def robot(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[RosCaller, list[Any]]]:
     logs = tmp_path_factory.mktemp("ros_logs")
     with (
-        running("tiago_sim.sim_node", "--world", str(WORLD), "--seed", "3", log_path=logs / "sim_node.log"),
+        running("tiago_twin", "--world", str(WORLD), "--seed", "3", log_path=logs / "sim_node.log"),
         running("tiago_sim.sequencer", "--world", str(WORLD), log_path=logs / "sequencer.log"),
     ):
         caller = RosCaller("test_ros_navigation")

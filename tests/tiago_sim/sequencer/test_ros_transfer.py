@@ -27,8 +27,8 @@ from std_srvs.srv import Trigger
 
 from tests.helpers.ros_processes import RosCaller, running
 from tests.helpers.sim_parameters import parameter_request
-from tiago_sim.sim_node.lab_reset import RESET_SERVICE
 from tiago_sim.sim_node.publishers import CAMERA_IMAGE_TOPIC, CAMERA_INFO_TOPIC
+from tiago_twin.lab_reset import RESET_SERVICE
 
 PLATE = "plate_001"
 TASK_TIMEOUT_S = 240.0
@@ -38,7 +38,7 @@ TASK_TIMEOUT_S = 240.0
 def robot(tmp_path_factory: pytest.TempPathFactory) -> Iterator[RosCaller]:
     logs = tmp_path_factory.mktemp("ros_logs")
     with (
-        running("tiago_sim.sim_node", "--seed", "7", log_path=logs / "sim_node.log") as sim,
+        running("tiago_twin", "--seed", "7", log_path=logs / "sim_node.log") as sim,
         running("tiago_sim.sequencer", log_path=logs / "sequencer.log") as sequencer,
     ):
         caller = RosCaller("test_ros_transfer")

@@ -22,11 +22,11 @@ from labware_interfaces.msg import ErrorCodes
 from rcl_interfaces.srv import SetParameters
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
+from lab_description.world import DEFAULT_WORLD, load_world
 from tests.helpers.ros_processes import RosCaller, running
 from tests.helpers.sim_parameters import parameter_request
-from tiago_sim.lab.world import DEFAULT_WORLD, load_world
+from tiago_description.robot_model import BASE_RADIUS
 from tiago_sim.navigation.blockage import STOP_SHORT_M
-from tiago_sim.robot.robot_model import BASE_RADIUS
 from tiago_sim.sim_node.navigation import BLOCKED_TIMEOUT_S
 
 BOX_LINE = re.compile(r"path-blocking box at x=(\S+) y=(\S+) yaw=(\S+) size (\S+) x (\S+) x")
@@ -36,7 +36,7 @@ CLOSEST_LINE = re.compile(r"the base came within (\S+) m of it")
 @pytest.fixture(scope="module")
 def robot(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[RosCaller, list[Pose2D], Path]]:
     log_path = tmp_path_factory.mktemp("ros_logs") / "sim_node.log"
-    with running("tiago_sim.sim_node", "--world", str(DEFAULT_WORLD), "--seed", "3", log_path=log_path):
+    with running("tiago_twin", "--world", str(DEFAULT_WORLD), "--seed", "3", log_path=log_path):
         caller = RosCaller("test_block_path")
         truth: list[Pose2D] = []
         try:

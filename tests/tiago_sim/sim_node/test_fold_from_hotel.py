@@ -1,8 +1,8 @@
 """play_motion Tuck from over the onboard hotel rises to the carry height before it folds the arm.
 
 Why: folding in joint space from the hotel's approach pose swings the finger pads over the front
-edge of the bench the robot works at (random layout 91089; tests/tiago_sim/robot/test_fold_sweep.py
-has the geometry). A fake run stands in for the sim thread: it records the motions asked for.
+edge of the bench the robot works at (random layout 91089; tests/tiago_description/test_fold_sweep.py
+has the geometry). A recording hardware stands in for the robot: it records the trajectories sent.
 """
 
 from __future__ import annotations
@@ -10,44 +10,44 @@ from __future__ import annotations
 from types import SimpleNamespace
 from typing import Any
 
-import numpy as np
 import pytest
+from labware_interfaces.action import PlayMotion
 
-from tiago_sim.robot import robot_model as rm
-from tiago_sim.robot.kinematics import RobotKinematics
-from tiago_sim.robot.motion_library import load_motions
-from tiago_sim.sim_node.behaviours import RobotBehaviours
+from robot_port.types import JointTrajectory
+from tiago_description import robot_model as rm
+from tiago_description.kinematics import RobotKinematics
+from tiago_description.motion_library import load_motions
+from tiago_skills.behaviours import RobotBehaviours
+from tiago_skills.goal_run import GoalRun
 
 ARM = "right"
 
 
-class FakeSim:
-    """Joint readings and the motions started, in order; a motion ends where it was sent."""
+class RecordingHardware:
+    """Joint readings and the trajectories sent, in order; a trajectory ends where it was sent."""
 
     def __init__(self, joints: dict[str, float]) -> None:
         self.joints = dict(joints)
-        self.started: list[tuple[str, Any]] = []
+        self.started: list[tuple[str, dict[str, float]]] = []
+
+    def now(self) -> float:
+        return 0.0
 
     def joint_positions(self) -> dict[str, float]:
         return dict(self.joints)
 
-    def move_tool(self, arm: str, T_base_grasp: np.ndarray, *_args: Any) -> None:
-        self.started.append(("move_tool", np.array(T_base_grasp)))
+    def follow_joint_trajectory(self, trajectory: JointTrajectory) -> Any:
+        self.started.append((trajectory.name, dict(trajectory.points[-1])))
+        self.joints.update(trajectory.points[-1])
+        return SimpleNamespace(
+            name=trajectory.name, done=True, success=True, error_code="", message="done",
+            progress=1.0, phase="done", remaining_s=0.0, result={}, wait=lambda _s: True, cancel=lambda: None,
+        )  # fmt: skip
 
-    def move_joints(self, targets: dict[str, float], _speed: float) -> None:
-        self.started.append(("move_joints", dict(targets)))
-        self.joints.update(targets)
 
-
-class FakeRun:
-    def __init__(self, sim: FakeSim) -> None:
-        self._sim = sim
-
-    def sim(self, job: Any) -> Any:
-        return job(self._sim)
-
-    def run_motion(self, start: Any, *, span: tuple[float, float] = (0.0, 1.0)) -> Any:
-        return start(self._sim)
+def goal_run(hardware: RecordingHardware) -> GoalRun:
+    handle = SimpleNamespace(is_cancel_requested=False, publish_feedback=lambda _message: None)
+    return GoalRun(handle, PlayMotion.Feedback, hardware)
 
 
 def behaviours() -> RobotBehaviours:
@@ -58,7 +58,6 @@ def behaviours() -> RobotBehaviours:
         hotel_slots=2,
         motions=load_motions(),
         speed_scale=lambda: 1.0,
-        navigation=SimpleNamespace(),
     )
 
 
@@ -78,11 +77,14 @@ def joints_over_hotel_slot(slot: int) -> dict[str, float]:
 @pytest.mark.parametrize("slot", [1, 2])
 def test_tuck_over_the_hotel_rises_to_the_carry_height_first(slot: int) -> None:
     robot = behaviours()
-    sim = FakeSim(joints_over_hotel_slot(slot))
-    robot.play_motion(FakeRun(sim), SimpleNamespace(arm=ARM, motion_name="Tuck", hotel_slot=0))
-    (kind, T_carry), *rest = sim.started
+    hardware = RecordingHardware(joints_over_hotel_slot(slot))
+    robot.play_motion(goal_run(hardware), SimpleNamespace(arm=ARM, motion_name="Tuck", hotel_slot=0))
+    (kind, carry_joints), *rest = hardware.started
     expected = robot.hotel_grasp_pose(slot, approach=True)[2, 3] + robot.motions.hotel.carry_height_m
-    assert kind == "move_tool" and T_carry[2, 3] == pytest.approx(expected)
+    assert kind == "move_tool"
+    assert robot.tool_pose(ARM, {**hardware.joints, **carry_joints})[2, 3] == pytest.approx(
+        expected, abs=1e-3
+    )
     assert [kind for kind, _ in rest] == ["move_joints"] * len(robot.motions.frames_for("Tuck", ARM))
 
 
@@ -91,6 +93,6 @@ def test_tuck_elsewhere_folds_straight_away() -> None:
     bench: dict[str, float] = {}
     for frame in robot.motions.frames_for("Benchtop", ARM):
         bench.update(frame)
-    sim = FakeSim(bench)
-    robot.play_motion(FakeRun(sim), SimpleNamespace(arm=ARM, motion_name="Tuck", hotel_slot=0))
-    assert [kind for kind, _ in sim.started] == ["move_joints"]
+    hardware = RecordingHardware(bench)
+    robot.play_motion(goal_run(hardware), SimpleNamespace(arm=ARM, motion_name="Tuck", hotel_slot=0))
+    assert [kind for kind, _ in hardware.started] == ["move_joints"]

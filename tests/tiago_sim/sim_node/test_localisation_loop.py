@@ -9,12 +9,12 @@ import math
 
 import pybullet as p
 
+from lab_description.world import load_world
 from tests.helpers.sim_steps import step_for
-from tiago_sim.lab.world import load_world
+from tiago_description.transforms import compose_planar
 from tiago_sim.physics.base_controller import CORRECTION_SPEED
 from tiago_sim.physics.simulation import Simulation
 from tiago_sim.sim_node.localisation import LocalisationLoop
-from tiago_sim.transforms import compose_planar
 
 
 def error_to_truth(sim: Simulation, pose) -> tuple[float, float]:

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from labware_interfaces.msg import RobotState
 
-from tiago_sim.sim_node.action_servers import RobotActivity
+from tiago_skills.action_servers import RobotActivity
 
 NAVIGATING, MANIPULATING = RobotState.STATE_NAVIGATING, RobotState.STATE_MANIPULATING
 

@@ -2,7 +2,7 @@
 
 Why: with the POI at the working distance, a base stopping 3 to 9 cm long swept the onboard hotel
 into the bench during its final turn and knocked the plate out (campaign seeds 100, 105). The POI
-now lies farther back; the marker-guided final approach (tiago_sim.sim_node.base_alignment) does the rest.
+now lies farther back; the marker-guided final approach (tiago_skills.base_alignment) does the rest.
 Odometry drift adds to the navigation error (seed 2041 stopped 18 cm long at 0.62 m: the tray hit
 the table during the turn), so the POI lies 0.72 m from the nests.
 Real PyBullet, no mocks.
@@ -17,15 +17,15 @@ import numpy as np
 import pybullet as p
 import pytest
 
+from lab_description.world import load_world
 from labware_model.holders import HotelSlot
 from labware_model.labware import Plate
-from tiago_sim import transforms as tf
-from tiago_sim.lab.world import load_world
+from tiago_description import transforms as tf
+from tiago_description.kinematics import RobotKinematics
+from tiago_description.robot_model import TOP_DOWN_REACH_BAND_M
+from tiago_description.transforms import compose_planar
 from tiago_sim.physics.simulation import Simulation
-from tiago_sim.robot.kinematics import RobotKinematics
-from tiago_sim.robot.robot_model import TOP_DOWN_REACH_BAND_M
-from tiago_sim.sim_node.base_alignment import ARM_SIDE_MARGIN_M, head_angles_towards, planar, working_pose
-from tiago_sim.transforms import compose_planar
+from tiago_skills.base_alignment import ARM_SIDE_MARGIN_M, head_angles_towards, planar, working_pose
 
 PLATE = "plate_001"
 

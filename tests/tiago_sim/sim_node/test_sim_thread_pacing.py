@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import time
 
-from tiago_sim.lab.world import load_world
+from lab_description.world import load_world
 from tiago_sim.physics.simulation import Simulation
 from tiago_sim.sim_node.sim_thread import SimThread
 

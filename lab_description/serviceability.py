@@ -1,0 +1,240 @@
+"""Can the TIAGo++ serve this lab? The checks the loader runs after the file's own rules.
+
+Why: a layout the robot cannot physically serve used to fail minutes into a run, as a motion error
+at the bench (issue 14). These four checks refuse it before anything moves, from the robot model's
+geometry (tiago_description), each with its numbers:
+
+- footprint: the base (radius `BASE_RADIUS`) at the docked pose, or along the straight undock drive to
+  the dock's POI, overlaps a bench; at a station's
+  working pose the hotel tray's turning circle (`HOTEL_SWEEP_RADIUS`) plus where the marker-guided
+  final approach may end (`WORKING_CLEARANCE`) does: that approach drives at the bearing to the
+  working pose and turns to the bench there. With bench edges 0.32 to 0.34 m ahead, `Benchtop`, `Tuck`
+  and `NestApproach` stopped with head or arm joints off their goals; in a direct reproduction the base
+  link, which carries the tray, pressed into the bench with kilonewtons and shook torso and head;
+- turning room: the circle the onboard hotel tray sweeps when the base turns at a POI
+  (`HOTEL_SWEEP_RADIUS` plus `TURN_MARGIN` for the navigation stop error) reaches a bench, its
+  own or another station's (stations too close together);
+- reach: no torso height and right-arm configuration puts the grasping frame top-down on a nest
+  (grasp and approach height, either finger order), IK on the pinocchio model from the working pose;
+- marker view: from the POI and from the working pose, the head camera aimed at the marker cannot
+  see it: pan or tilt beyond the head's limits, too near or too far, seen too obliquely, or too small
+  in the image.
+
+Pure computation (pinocchio, numpy); safe on any thread that owns its own `RobotKinematics`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from tiago_description import robot_model
+from tiago_description import transforms as tf
+from tiago_description.hotel_model import hotel_sweep_radius
+from tiago_description.kinematics import CAMERA_FRAME, RobotKinematics, head_angles_towards
+from tiago_description.motion_library import HotelGrasp, load_motions
+
+BASE_RADIUS = robot_model.BASE_RADIUS
+HOTEL_SWEEP_RADIUS = hotel_sweep_radius()
+"""The onboard hotel tray's farthest corner from the base centre (m): the circle a turn sweeps (0.354)."""
+TURN_MARGIN = 0.05
+"""Navigation stops up to a few cm off its POI (30 mm per axis, one sigma, by default)."""
+ALIGN_SIGHTING_ERROR = 0.010
+"""How much nearer the bench the working pose the marker shows from the POI may lie than the real one
+(m): the head camera's calibration (mount 1 mm and 0.1 deg per axis, head encoder zeros 0.1 deg, depth
+bias 1 mm at 1 m; one sigma each) over the 0.7 to 0.9 m to the marker, at three sigma (draws of about
+two sigma were measured to give 7 mm)."""
+ALIGN_DRIVE_OVERSHOOT = 0.006
+"""How far the final approach's drive passes its goal's line towards the bench (m): closing on a goal
+beside its heading, the drive curves in and crosses the line by up to 5.6 mm (0.21 m ahead, 0 to
+0.1 m aside) before it stops and turns."""
+WORKING_CLEARANCE = HOTEL_SWEEP_RADIUS + ALIGN_SIGHTING_ERROR + ALIGN_DRIVE_OVERSHOOT
+"""A working pose's least distance from every bench (m): the tray's turning circle, which the final
+approach sweeps in part (it drives at the bearing to the working pose, then turns to the bench), plus
+where that approach may end: with the circle taken as 0.35 m and no margin, a working pose 0.361 m
+from its bench let the tray touch it (the base ended 12 mm nearer than its working pose)."""
+REACH_ARM = "right"
+LOOK_TORSO_LIFT = 0.15
+"""The torso height of "Travel", where the first look at a station's marker is taken (m)."""
+CAMERA_FOCAL_PX = 522.2
+MARKER_DISTANCE_RANGE = (0.4, 1.6)
+"""Camera to marker centre (m): the camera clips at 0.3 m; beyond 1.5 to 2.5 m detection failed."""
+MARKER_MAX_OBLIQUITY_DEG = 60.0
+"""Angle between the marker's normal and the line to the camera; ArUco corners blur beyond this."""
+MARKER_MIN_PIXELS = 40.0
+"""Side of the black square in the 640 x 480 image; the pose error grows fast below this."""
+_FLIP_ABOUT_APPROACH = tf.make_transform(rotation=np.diag([1.0, -1.0, -1.0]))
+
+
+@dataclass(frozen=True)
+class ServiceProblem:
+    """A station (index, or -1 for the dock) the robot cannot serve, and why with the numbers."""
+
+    station_index: int
+    what: str
+
+    @property
+    def where(self) -> str:
+        return "dock" if self.station_index < 0 else f"stations[{self.station_index}]"
+
+
+@lru_cache(maxsize=1)
+def _robot() -> tuple[RobotKinematics, HotelGrasp, dict[str, float]]:
+    motions = load_motions()
+    seed: dict[str, float] = {}
+    for frame in motions.frames_for("Benchtop", REACH_ARM):
+        seed.update(frame)
+    return RobotKinematics(), motions.hotel, seed
+
+
+def service_problems(world) -> list[ServiceProblem]:  # noqa: ANN001 - a lab.world.World (no import cycle)
+    """Every reason the robot cannot serve `world`, station by station (empty: it can)."""
+    problems = list(_footprint_problems(world))
+    for index, station in enumerate(world.stations):
+        problems += [ServiceProblem(index, what) for what in _station_problems(world, station)]
+    problems.sort(key=lambda problem: problem.station_index)
+    return problems
+
+
+def bench_distance(station, x: float, y: float) -> float:  # noqa: ANN001
+    """Distance (m) from floor point (x, y) to the station's bench outline; negative inside it."""
+    return float(bench_distances(station, np.asarray(x, dtype=float), np.asarray(y, dtype=float)))
+
+
+def bench_distances(station, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:  # noqa: ANN001
+    """`bench_distance` for many floor points at once (a drive sampled every few centimetres)."""
+    pose = station.table_pose
+    c, s = math.cos(pose.yaw), math.sin(pose.yaw)
+    dx, dy = xs - pose.x, ys - pose.y
+    depth, width = station.table_size[0], station.table_size[1]
+    along = np.abs(c * dx + s * dy) - depth / 2
+    across = np.abs(-s * dx + c * dy) - width / 2
+    outside = np.hypot(np.maximum(along, 0.0), np.maximum(across, 0.0))
+    return np.where(outside > 0, outside, np.maximum(along, across))
+
+
+def drive_points(start, end, count: int) -> tuple[np.ndarray, np.ndarray]:  # noqa: ANN001 - Pose2D
+    """`count` + 1 floor points evenly along the straight drive from `start` to `end`, both ends in."""
+    k = np.arange(count + 1, dtype=float) / count
+    return start.x + (end.x - start.x) * k, start.y + (end.y - start.y) * k
+
+
+def _footprint_problems(world) -> Iterator[ServiceProblem]:  # noqa: ANN001
+    dock_poses = (("the docked pose", world.dock_pose, BASE_RADIUS),)
+    dock_poi = world.pois[world.dock_poi]
+    dock_poses += ((f"POI {world.dock_poi}", dock_poi, HOTEL_SWEEP_RADIUS + TURN_MARGIN),)
+    for label, pose, radius in dock_poses:
+        for station in world.stations:
+            yield from (ServiceProblem(-1, what) for what in _clear(label, pose, radius, station))
+    yield from (ServiceProblem(-1, what) for what in _undock_problems(world, dock_poi))
+
+
+def _undock_problems(world, dock_poi) -> Iterator[str]:  # noqa: ANN001
+    """The undock drives straight from the docked pose to the dock's POI without turning: the base's
+    footprint (the tray lies within it across) plus the navigation error must keep off every bench
+    along it: a bench one base radius from that line is grazed although the docked pose and the POI
+    are both clear of it."""
+    xs, ys = drive_points(world.dock_pose, dock_poi, 20)
+    need = BASE_RADIUS + TURN_MARGIN
+    for station in world.stations:
+        gaps = bench_distances(station, xs, ys)
+        nearest = int(np.argmin(gaps))
+        if gaps[nearest] < need:
+            yield (
+                f"the undock drive from the docked pose to POI {world.dock_poi} passes {gaps[nearest]:.3f} m "
+                f"from bench {station.name!r} (at x {xs[nearest]:.3f} y {ys[nearest]:.3f} m); the base's "
+                f"footprint and the navigation error need {need:.3f} m"
+            )
+
+
+def _clear(label: str, pose, radius: float, station) -> Iterator[str]:  # noqa: ANN001
+    gap = bench_distance(station, pose.x, pose.y)
+    if gap < radius:
+        need = {
+            BASE_RADIUS: "its footprint",
+            WORKING_CLEARANCE: "the hotel tray's turning circle and the final approach's error",
+        }.get(radius, "the hotel tray's turning circle and the navigation error")
+        yield (
+            f"{label} at x {pose.x:.3f} y {pose.y:.3f} m is {gap:.3f} m from bench {station.name!r}; "
+            f"{need} needs {radius:.3f} m"
+        )
+
+
+def _station_problems(world, station) -> list[str]:  # noqa: ANN001
+    poi, working = station.work_pose(), station.aligned_pose()
+    problems: list[str] = []
+    for other in world.stations:
+        turning = HOTEL_SWEEP_RADIUS + TURN_MARGIN
+        problems += _clear(f"{station.name!r}: the base at POI {station.poi}", poi, turning, other)
+        problems += _clear(
+            f"{station.name!r}: the base at the working pose", working, WORKING_CLEARANCE, other
+        )
+    problems += _reach_problems(station, working)
+    for label, pose in ((f"POI {station.poi}", poi), ("the working pose", working)):
+        problems += _view_problems(station, label, pose)
+    return problems
+
+
+def _reach_problems(station, working) -> list[str]:  # noqa: ANN001
+    kinematics, grasp, seed = _robot()
+    T_base_world = tf.invert(working.matrix())
+    problems = []
+    for sub_position in range(1, station.sub_positions + 1):
+        T_base_site = tf.levelled(T_base_world @ station.T_world_site(sub_position))
+        heights = (("the grasp", 0.0), ("the approach", station.approach_height))
+        for label, height in heights:
+            T_base_grasp = T_base_site @ tf.make_transform((0.0, 0.0, height)) @ grasp.T_slot_grasp(False)
+            if not _reachable(kinematics, T_base_grasp, seed):
+                x, y, z = T_base_site[:3, 3]
+                problems.append(
+                    f"{station.name!r}: nest {sub_position} is out of the {REACH_ARM} arm's reach at "
+                    f"any torso height ({label}, {height * 1000:.0f} mm above the nest: x {x:.3f} y {y:.3f} "
+                    f"z {z:.3f} m in the working pose's base_footprint)"
+                )
+                break
+    return problems
+
+
+def _reachable(kinematics: RobotKinematics, T_base_grasp: np.ndarray, seed: dict[str, float]) -> bool:
+    for twin in (T_base_grasp, T_base_grasp @ _FLIP_ABOUT_APPROACH):
+        if kinematics.inverse(REACH_ARM, twin, seed, use_torso=True, restarts=20).success:
+            return True
+    return False
+
+
+def _view_problems(station, label: str, pose) -> list[str]:  # noqa: ANN001
+    kinematics, _grasp, _seed = _robot()
+    T_base_marker = tf.invert(pose.matrix()) @ station.T_world_marker()
+    target = T_base_marker[:3, 3]
+    aim = head_angles_towards(kinematics, {"torso_lift_joint": LOOK_TORSO_LIFT}, target)
+    pan, tilt = aim["head_1_joint"], aim["head_2_joint"]
+    head = {joint.name: joint.limits_deg for joint in robot_model.HEAD_JOINTS}
+    joints = {"torso_lift_joint": LOOK_TORSO_LIFT, "head_1_joint": pan, "head_2_joint": tilt}
+    camera = kinematics.forward(joints, CAMERA_FRAME)[:3, 3]
+    to_camera = camera - target
+    distance = float(np.linalg.norm(to_camera))
+    obliquity = math.degrees(math.acos(np.clip(T_base_marker[:3, 2] @ to_camera / distance, -1.0, 1.0)))
+    pixels = CAMERA_FOCAL_PX * station.marker_size / distance
+    reasons = []
+    for name, angle in (("head_1", pan), ("head_2", tilt)):
+        low, high = head[name]
+        if not low <= math.degrees(angle) <= high:
+            reasons.append(f"{name} would need {math.degrees(angle):.0f} deg (limits {low:g} .. {high:g})")
+    if not MARKER_DISTANCE_RANGE[0] <= distance <= MARKER_DISTANCE_RANGE[1]:
+        low, high = MARKER_DISTANCE_RANGE
+        reasons.append(f"the marker is {distance:.2f} m from the camera (usable {low:g} .. {high:g} m)")
+    if obliquity > MARKER_MAX_OBLIQUITY_DEG:
+        reasons.append(
+            f"the marker is seen {obliquity:.0f} deg off its face's normal "
+            f"(at most {MARKER_MAX_OBLIQUITY_DEG:g})"
+        )
+    elif pixels < MARKER_MIN_PIXELS:
+        reasons.append(f"the marker is {pixels:.0f} px wide in the image (at least {MARKER_MIN_PIXELS:g})")
+    if not reasons:
+        return []
+    seeing = f"{station.name!r}: the head camera cannot see marker {station.marker_id} from {label}"
+    return [f"{seeing}: " + "; ".join(reasons)]

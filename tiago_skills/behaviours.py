@@ -1,0 +1,349 @@
+"""What the base, arm and gripper goals do: navigate, dock, undock, play motion, gripper.
+
+Each method is an execute function for action_servers.RobotActionServers: it validates the goal
+(raising ActionAbort with a code and a reason before anything moves), then reads and commands the
+hardware (robot_port) through the goal's GoalRun. Parameters (POIs, speeds) are read from the node's
+current ROS parameters at goal time, so changing them at runtime takes effect on the next goal.
+Lives on: rclpy executor threads (one goal at a time, see MotionSlot).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import threading
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from labware_interfaces.msg import ErrorCodes
+
+from robot_port.execution import Execution
+from robot_port.hardware import RobotHardware
+from robot_port.types import ARM_SIDES, JointTrajectory
+from tiago_description.kinematics import RobotKinematics
+from tiago_description.motion_library import HOTEL_MOTIONS, MotionLibrary
+from tiago_description.transforms import make_transform
+from tiago_skills.goal_run import ActionAbort, GoalRun
+from tiago_skills.tool_path import STRAIGHT_STEP, plan_tool_path
+
+log = logging.getLogger(__name__)
+
+# Straight tool moves (m/s along the line; joint limits cap them too): slow where the plate enters a
+# nest or hotel pocket, where chamfers guide it; faster in free space (approach, lift, carry).
+TOOL_SPEED_INTO_POCKET = 0.08
+# 0.15 once "lost the plate" (SLOT_EMPTY): that was the hotel tray hitting the table, see base_alignment
+TOOL_SPEED_FREE = 0.35
+CREEP_HEIGHT = 0.018  # m above a pocket where the slow creep starts (rims: nest 6 mm, hotel 8 mm)
+
+# Half-turn about the grasp x axis: the same top-down grasp with the fingers swapped.
+FLIP_ABOUT_APPROACH = make_transform(rotation=np.diag([1.0, -1.0, -1.0]))
+
+
+def move_joints(targets: dict[str, float], speed_scale: float = 1.0) -> Callable[[RobotHardware], Execution]:
+    """The command that moves joints to `targets` in one segment (for GoalRun.follow)."""
+    return lambda hardware: hardware.follow_joint_trajectory(JointTrajectory((dict(targets),), speed_scale))
+
+
+class RobotBehaviours:
+    """Execute functions of the robot-level actions (one instance per robot)."""
+
+    def __init__(
+        self,
+        *,
+        poi_pose: Callable[[str], tuple[float, float, float] | None],
+        poi_names: Callable[[], list[str]],
+        dock_poi: Callable[[], str],
+        hotel_slots: int,
+        motions: MotionLibrary,
+        speed_scale: Callable[[], float],
+        seed: int | None = None,
+    ) -> None:
+        self.poi_pose = poi_pose
+        self.poi_names = poi_names
+        self.dock_poi = dock_poi
+        self.hotel_slots = hotel_slots
+        self.motions = motions
+        self.speed_scale = speed_scale
+        self._rng = np.random.default_rng(seed)  # IK restarts' seeds
+        self._kinematics = RobotKinematics()
+        self._kinematics_lock = threading.Lock()
+        self.grasp_flipped: dict[str, bool] = {}  # per arm: twin of the top-down grasp last used
+        self.holding: dict[str, bool] = {}  # per arm: the last gripper command closed on a plate
+
+    # -- checks ------------------------------------------------------------------------
+    def arm_of(self, requested: str) -> str:
+        arm = requested or self.motions.default_arm
+        if arm not in ARM_SIDES:
+            raise ActionAbort(
+                ErrorCodes.BAD_GOAL, f"unknown arm {requested!r}: use one of {', '.join(ARM_SIDES)}"
+            )
+        return arm
+
+    def check_hotel_slot(self, slot: int) -> None:
+        if not 1 <= slot <= self.hotel_slots:
+            raise ActionAbort(
+                ErrorCodes.UNKNOWN_SLOT, f"unknown hotel slot {slot}: the robot has 1..{self.hotel_slots}"
+            )
+
+    # -- base ----------------------------------------------------------------------------
+    def navigate(self, run: GoalRun, goal: Any) -> dict:
+        pose = self.poi_pose(goal.poi)
+        if pose is None:
+            raise ActionAbort(
+                ErrorCodes.UNKNOWN_POI, f"unknown POI {goal.poi!r}: known are {', '.join(self.poi_names())}"
+            )
+        if run.read(lambda hardware: hardware.is_docked()):
+            raise ActionAbort(ErrorCodes.DOCKED, "the robot is docked: undock first")
+        lowering = self._lower_torso(run)
+        try:
+            # The drive has the whole progress: the torso lowers beside it and is nearly always down
+            # before the base arrives. With a share kept for the lowering, the drive's last report
+            # said 95 % done and 0 s left while nothing was left to do (a client saw it under load:
+            # test_remaining_time_is_never_zero_while_the_robot_still_moves[prepare] in CI); a
+            # torso still lowering after the drive reports its own remaining time at 100 %.
+            name = f"POI {goal.poi!r}"
+            run.follow(lambda hardware: hardware.navigate_to(pose, name), span=(0.0, 1.0))
+            if lowering is not None:
+                run.follow(lowering, span=(1.0, 1.0))
+        except BaseException:
+            run.stop([lowering])  # a cancelled drive stops the torso too
+            raise
+        return {}
+
+    def _lower_torso(self, run: GoalRun) -> Any:
+        """Start the torso down to the travel height of "Travel" (it runs while the base drives)."""
+        travel = [
+            frame["torso_lift_joint"]
+            for frame in self.motions.keyframes.get("Travel", [])
+            if "torso_lift_joint" in frame
+        ]
+        if not travel:
+            return None
+        height = run.read(lambda hardware: hardware.joint_positions()["torso_lift_joint"])
+        if height <= travel[-1] + 0.01:
+            return None
+        speed = self.speed_scale() * self.motions.speed_scale
+        return run.read(move_joints({"torso_lift_joint": travel[-1]}, speed))
+
+    def dock(self, run: GoalRun, _goal: Any) -> dict:
+        if run.read(lambda hardware: hardware.is_docked()):
+            return {}
+        pose = self.poi_pose(self.dock_poi())
+        if pose is not None:
+            name = f"the dock POI {self.dock_poi()!r}"
+            run.follow(lambda hardware: hardware.navigate_to(pose, name), span=(0.0, 0.6), later_s=10.0)
+        run.follow(lambda hardware: hardware.dock(), span=(0.6 if pose is not None else 0.0, 1.0))
+        return {}
+
+    def undock(self, run: GoalRun, _goal: Any) -> dict:
+        if not run.read(lambda hardware: hardware.is_docked()):
+            return {}
+        run.follow(lambda hardware: hardware.undock())
+        return {}
+
+    # -- arm ----------------------------------------------------------------------------
+    def play_motion(self, run: GoalRun, goal: Any) -> dict:
+        arm = self.arm_of(goal.arm)
+        name = goal.motion_name
+        if name in HOTEL_MOTIONS:
+            self.check_hotel_slot(int(goal.hotel_slot))
+            self._hotel_motion(run, arm, name, int(goal.hotel_slot))
+            return {}
+        if name not in self.motions.keyframes:
+            raise ActionAbort(
+                ErrorCodes.BAD_GOAL, f"unknown motion {name!r}: known are {', '.join(self.motions.names())}"
+            )
+        frames = self.motions.frames_for(name, arm)
+        # Every fixed motion leaves the hotel straight up to the carry height first: a held plate is
+        # never swept through the hotel, and an empty gripper folding from the hotel's approach pose
+        # (0.71 m high) swings its pads up to 0.40 m ahead of the base at 0.77 m, where a bench's front
+        # edge (0.36 .. 0.45 m ahead at a working pose, top up to 0.78 m) stands: Tuck after
+        # GetLabware has grazed such an edge 1.5 mm deep. From the carry height the fold
+        # stays above 0.85 m (tests/tiago_description/test_fold_sweep.py).
+        first = self.leave_hotel(run, arm)
+        speed = self.speed_scale() * self.motions.speed_scale
+        for index, targets in enumerate(frames):
+            span = (
+                first + (1 - first) * index / len(frames),
+                first + (1 - first) * (index + 1) / len(frames),
+            )
+            run.follow(move_joints(targets, speed), span=span)
+        return {}
+
+    def solve_ik(
+        self, arm: str, T_base_grasp: Any, seed_positions: dict[str, float], *, use_torso: bool = True
+    ) -> dict[str, float] | None:
+        """Joint targets for the grasping frame at T_base_grasp, or None when unreachable."""
+        with self._kinematics_lock:
+            result = self._kinematics.inverse(
+                arm, T_base_grasp, seed_positions, use_torso=use_torso, restarts=60
+            )
+        return dict(result.joint_positions) if result.success else None
+
+    def tool_pose(self, arm: str, joint_positions: dict[str, float]) -> np.ndarray:
+        with self._kinematics_lock:
+            return self._kinematics.forward(joint_positions, f"gripper_{arm}_grasping_frame")
+
+    def grasp_twin(self, arm: str, T_base_grasp: np.ndarray, seed: dict[str, float]) -> np.ndarray:
+        """A top-down grasp pose or its twin with the fingers swapped (half-turn about the approach).
+
+        With a plate in the gripper, the twin used when it was grasped, so the plate keeps its
+        orientation from nest to hotel and back; otherwise the one the arm reaches with less joint
+        travel (e.g. 1.5 instead of 2.7 rad from the tucked arm to the hotel).
+        """
+        twins = {False: T_base_grasp, True: T_base_grasp @ FLIP_ABOUT_APPROACH}
+        order = [self.grasp_flipped.get(arm, False)] if self.holding.get(arm) else [False, True]
+        travel = {}  # twin -> largest joint change to reach it (the slowest joint sets the pace)
+        for flip in order:
+            joints = self.solve_ik(arm, twins[flip], seed)
+            if joints is not None:
+                travel[flip] = max(abs(value - seed.get(name, value)) for name, value in joints.items())
+        if travel:
+            flip = min(travel, key=travel.get)
+            self.grasp_flipped[arm] = flip
+            return twins[flip]
+        raise ActionAbort(
+            ErrorCodes.IK_FAILED, f"the {arm} arm cannot reach {np.round(T_base_grasp[:3, 3], 3)}"
+        )
+
+    def hotel_grasp_pose(self, slot: int, approach: bool, releasing: bool = False) -> np.ndarray:
+        with self._kinematics_lock:
+            T_base_slot = self._kinematics.forward({}, f"hotel_slot_{slot}")
+        return T_base_slot @ self.motions.hotel.T_slot_grasp(approach, releasing)
+
+    def _tool_move(
+        self,
+        run: GoalRun,
+        arm: str,
+        T_base_grasp: np.ndarray,
+        span: tuple[float, float],
+        *,
+        free: bool = False,
+        tool_speed: float = TOOL_SPEED_FREE,
+    ) -> None:
+        """Straight tool move to a top-down grasp pose; with `free`, a joint-space move when the
+        gripper is empty or no straight line exists (e.g. from the folded arm, where nothing is in
+        the way)."""
+        seed = run.read(lambda hardware: dict(hardware.joint_positions()))
+        target = self.grasp_twin(arm, T_base_grasp, seed)
+        if free and not self.holding.get(arm):  # an empty gripper from the tucked arm: the short way
+            self.joint_space_move(run, arm, target, span)
+            return
+        try:
+            self.straight_move(run, arm, target, tool_speed, span)
+        except ActionAbort as abort:
+            if not free or abort.code != ErrorCodes.IK_FAILED:
+                raise
+            self.joint_space_move(run, arm, target, span)
+
+    def into_pocket(
+        self, run: GoalRun, arm: str, T_base_grasp: np.ndarray, span: tuple[float, float]
+    ) -> None:
+        """Down into a nest or hotel pocket: fast to CREEP_HEIGHT above it, then slowly the rest."""
+        joints = run.read(lambda hardware: dict(hardware.joint_positions()))
+        height = self.tool_pose(arm, joints)[2, 3] - T_base_grasp[2, 3]
+        low, high = span
+        if height > CREEP_HEIGHT + 0.01:
+            T_above = T_base_grasp.copy()
+            T_above[2, 3] += CREEP_HEIGHT
+            middle = low + (high - low) * 0.6
+            self.straight_move(run, arm, T_above, TOOL_SPEED_FREE, (low, middle))
+            low = middle
+        self.straight_move(run, arm, T_base_grasp, TOOL_SPEED_INTO_POCKET, (low, high))
+
+    def straight_move(
+        self, run: GoalRun, arm: str, T_base_grasp: np.ndarray, tool_speed: float, span: tuple[float, float]
+    ) -> None:
+        """Straight tool move by the arm alone if it can (the torso lifts at only 0.07 m/s and would
+        set the pace of every vertical move), else with the torso. A path that fails its IK check
+        fails before anything moves, so the second try starts from the same state."""
+        try:
+            line = self.tool_line(run, arm, T_base_grasp, tool_speed, use_torso=False)
+        except ActionAbort as abort:
+            if abort.code != ErrorCodes.IK_FAILED:
+                raise
+            log.info("the arm alone cannot follow the line (%s): planning with the torso", abort.message)
+            line = self.tool_line(run, arm, T_base_grasp, tool_speed, use_torso=True)
+        run.follow(lambda hardware: hardware.follow_joint_trajectory(line), span=span)
+
+    def tool_line(
+        self, run: GoalRun, arm: str, T_base_grasp: np.ndarray, tool_speed: float, *, use_torso: bool
+    ) -> JointTrajectory:
+        """The joint trajectory that moves the grasping frame along a straight line to T_base_grasp
+        at up to `tool_speed` (m/s; the joints' limits cap it too); IK_FAILED naming the waypoint
+        where no line exists."""
+        current = run.read(lambda hardware: hardware.joint_positions())
+        with self._kinematics_lock:
+            planned = plan_tool_path(self._kinematics, self._rng, arm, current, T_base_grasp, True, use_torso)
+        if isinstance(planned, str):
+            raise ActionAbort(ErrorCodes.IK_FAILED, planned)
+        segment_s = STRAIGHT_STEP / max(tool_speed, 1e-3)
+        return JointTrajectory(tuple(planned), 1.0, min_segment_s=segment_s, name="move_tool")
+
+    def joint_space_move(
+        self, run: GoalRun, arm: str, T_base_grasp: np.ndarray, span: tuple[float, float]
+    ) -> None:
+        """Where no straight tool path exists (e.g. from the folded arm): one joint-space move.
+
+        The arm alone first (the torso lifts at only 0.07 m/s and would set the pace), the torso too
+        only if the arm alone cannot reach; 60 seeded IK restarts rather than the simulator's 30
+        (30 have found no solution for the hotel from the tucked arm).
+        """
+        log.info("no straight path to %s: moving in joint space", np.round(T_base_grasp[:3, 3], 3))
+        seed = run.read(lambda hardware: dict(hardware.joint_positions()))
+        joints = self.solve_ik(arm, T_base_grasp, seed, use_torso=False) or self.solve_ik(
+            arm, T_base_grasp, seed
+        )
+        if joints is None:
+            raise ActionAbort(
+                ErrorCodes.IK_FAILED, f"the {arm} arm cannot reach {np.round(T_base_grasp[:3, 3], 3)}"
+            )
+        speed = self.speed_scale() * self.motions.speed_scale
+        run.follow(move_joints(joints, speed), span=span)
+
+    def _over_slot(self, arm: str, joints: dict[str, float], slot: int, radius_m: float) -> bool:
+        tool = self.tool_pose(arm, joints)[:3, 3]
+        return float(np.hypot(*(tool[:2] - self.hotel_grasp_pose(slot, True)[:2, 3]))) < radius_m
+
+    def leave_hotel(self, run: GoalRun, arm: str) -> float:
+        """If the tool is over a hotel slot, rise straight to the carry height; returns progress used."""
+        joints = run.read(lambda hardware: dict(hardware.joint_positions()))
+        for slot in range(1, self.hotel_slots + 1):
+            if self._over_slot(arm, joints, slot, 0.05):
+                T_carry = self.tool_pose(arm, joints)
+                T_carry[2, 3] = self.hotel_grasp_pose(slot, True)[2, 3] + self.motions.hotel.carry_height_m
+                self.straight_move(run, arm, T_carry, TOOL_SPEED_FREE, (0.0, 0.3))
+                return 0.3
+        return 0.0
+
+    def _hotel_motion(self, run: GoalRun, arm: str, name: str, slot: int) -> None:
+        T_approach = self.hotel_grasp_pose(slot, approach=True)
+        if name == "Nest":  # straight down into the pocket (back up: NestApproach)
+            T_nest = self.hotel_grasp_pose(slot, approach=False, releasing=self.holding.get(arm, False))
+            seed = run.read(lambda hardware: dict(hardware.joint_positions()))
+            self.into_pocket(run, arm, self.grasp_twin(arm, T_nest, seed), (0.0, 1.0))
+            return
+        joints = run.read(lambda hardware: dict(hardware.joint_positions()))
+        if self._over_slot(arm, joints, slot, 0.03):  # straight up or down to the approach pose
+            self._tool_move(run, arm, T_approach, (0.0, 1.0))
+            return
+        # From elsewhere: straight to the carry height above the slot, then straight down.
+        T_carry = T_approach.copy()
+        T_carry[2, 3] += self.motions.hotel.carry_height_m
+        self._tool_move(run, arm, T_carry, (0.0, 0.7), free=True)
+        self._tool_move(run, arm, T_approach, (0.7, 1.0))
+
+    # -- gripper ------------------------------------------------------------------------
+    def gripper(self, run: GoalRun, goal: Any) -> dict:
+        arm = self.arm_of(goal.arm)
+        if goal.command not in ("open", "close"):
+            raise ActionAbort(
+                ErrorCodes.BAD_GOAL, f"unknown gripper command {goal.command!r}: use open or close"
+            )
+        close = goal.command == "close"
+        self.holding[arm] = False if not close else self.holding.get(arm, False)
+        execution = run.follow(lambda hardware: hardware.gripper(arm, close))
+        holding = bool(execution.result.get("holding", False))
+        self.holding[arm] = close and holding
+        return {"holding": holding, "opening_m": float(execution.result.get("opening_m", math.nan))}

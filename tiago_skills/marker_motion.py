@@ -1,0 +1,226 @@
+"""MarkerMotion: move the tool to a nest located from the station's ArUco marker (robot software).
+
+Why this is robot software and not simulation: it uses only what a real TIAGo has - the head
+camera's pixels and depth, its joint readings and its kinematic model. The marker pose comes from
+perception.detect_marker on the rendered image; the camera pose in base_footprint from forward
+kinematics of the joint readings taken with the image; never from simulator link states.
+
+Target "work_pose" moves the base instead (tiago_skills.base_alignment): from the station's POI to
+the working pose in front of the nests, as the marker shows it.
+
+Steps: take an image (the hardware port) -> detect the marker (this thread) -> T_base_marker =
+T_base_optical @ T_optical_marker -> the nest frame from the world's site_in_marker, sub-position
+spacing and approach height -> the grasp pose in that frame (fingers down, closing across the
+plate's short side; the flipped twin if IK prefers it) -> a straight tool line (behaviours). A sighting is
+reused while the base has not moved: the marker is fixed to its station, so its pose in
+base_footprint holds whatever arms, torso and head do since (and the arm above the nest hides the
+marker from the head). Lives on: an rclpy executor thread (one goal at a time).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import threading
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from geometry_msgs.msg import Pose
+from labware_interfaces.msg import ErrorCodes
+
+from lab_description.world import World
+from tiago_description import transforms as tf
+from tiago_description.kinematics import RobotKinematics
+from tiago_description.motion_library import HotelGrasp
+from tiago_skills.base_alignment import align_base, working_pose
+from tiago_skills.behaviours import TOOL_SPEED_FREE, TOOL_SPEED_INTO_POCKET, RobotBehaviours
+from tiago_skills.goal_run import ActionAbort, GoalRun
+from tiago_skills.perception.aruco import detect_marker
+from tiago_skills.perception.site_frames import nest_in_base
+from tiago_skills.place_correction import place_shift
+
+log = logging.getLogger(__name__)
+
+TARGETS = ("site_approach", "site", "work_pose")
+LINE_ONLY_RADIUS_M = 0.03  # a tool this near the column above the site moves only in straight lines
+CAMERA_FRAME = "head_front_camera_rgb_optical_frame"
+# A cached marker stays valid while odometry moved less than this.
+SAME_BASE_POSITION_M = 0.002
+SAME_BASE_YAW_RAD = 0.003
+
+
+@dataclass(frozen=True)
+class MarkerSighting:
+    station: str
+    T_base_marker: np.ndarray
+    odometry: tuple[float, float, float]
+    reprojection_error_px: float
+    joints: dict[str, float] = field(default_factory=dict)  # readings taken with the image
+
+
+def pose_msg(transform: np.ndarray) -> Pose:
+    position, quat = tf.to_pose(transform)
+    pose = Pose()
+    pose.position.x, pose.position.y, pose.position.z = (float(v) for v in position)
+    pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w = (float(v) for v in quat)
+    return pose
+
+
+class MarkerMotionBehaviour:
+    """Execute function of /marker_motion."""
+
+    def __init__(self, world: World, behaviours: RobotBehaviours, grasp: HotelGrasp) -> None:
+        self.world = world
+        self.behaviours = behaviours
+        self.grasp = grasp
+        self.kinematics = RobotKinematics()
+        self._lock = threading.Lock()
+        self.last_sighting: MarkerSighting | None = None
+
+    def look(self, run: GoalRun, station_name: str) -> MarkerSighting:
+        """Image + joints at one instant, marker detection, marker pose in base_footprint."""
+        station = self.world.station(station_name)
+
+        run.feedback(max(run.progress, 0.05), "looking", 0.0, force=True)  # progress never goes back
+        frame = run.read(lambda hardware: hardware.capture_head_camera())
+        observation = detect_marker(
+            frame.rgb, frame.intrinsics, station.marker_id, station.marker_size, frame.depth
+        )
+        if observation is None:
+            raise ActionAbort(ErrorCodes.MARKER_NOT_FOUND, f"marker not found: {station.marker_id}")
+        with self._lock:
+            T_base_optical = self.kinematics.forward(frame.joints, CAMERA_FRAME)
+        sighting = MarkerSighting(
+            station_name,
+            T_base_optical @ observation.T_optical_marker,
+            tuple(frame.odometry),
+            observation.reprojection_error_px,
+            dict(frame.joints),
+        )
+        log.info(
+            "marker %d of %s at %s in base, quaternion %s (reprojection %.2f px)",
+            station.marker_id, station_name, np.round(sighting.T_base_marker[:3, 3], 4),
+            np.round(tf.matrix_to_quat(sighting.T_base_marker[:3, :3]), 5), observation.reprojection_error_px,
+        )  # fmt: skip
+        self.last_sighting = sighting
+        return sighting
+
+    def _cached(self, run: GoalRun, station_name: str) -> MarkerSighting | None:
+        sighting = self.last_sighting
+        if sighting is None or sighting.station != station_name:
+            return None
+        x, y, yaw = run.read(lambda hardware: tuple(hardware.odometry()))
+        moved = math.hypot(x - sighting.odometry[0], y - sighting.odometry[1])
+        turned = abs(math.remainder(yaw - sighting.odometry[2], math.tau))
+        return sighting if moved < SAME_BASE_POSITION_M and turned < SAME_BASE_YAW_RAD else None
+
+    def _centred_on_plate(
+        self, run: GoalRun, arm: str, T_base_site: np.ndarray, sighting: MarkerSighting
+    ) -> np.ndarray:
+        """The site moved by the shift that centres the held plate on it (as it is without a
+        measurement). Taken from where the tool stands now, above the nest after the approach."""
+
+        def capture() -> tuple:
+            frame = run.read(lambda hardware: hardware.capture_head_camera())
+            return frame.depth, frame.intrinsics, dict(frame.joints)
+
+        def forward(joints: dict[str, float], frame: str) -> np.ndarray:
+            with self._lock:
+                return self.kinematics.forward(joints, frame)
+
+        shift = place_shift(
+            capture,
+            forward,
+            T_base_site,
+            arm,
+            CAMERA_FRAME,
+            sighting.joints,
+            self.world.labware_types.values(),
+            self.grasp.grasp_height_m,
+        )
+        if shift is None:
+            return T_base_site
+        return T_base_site @ tf.from_planar(*shift)
+
+    def _may_leave_the_line(self, run: GoalRun, arm: str, T_base_target: np.ndarray) -> bool:
+        """Whether a move to the site's approach pose may go in joint space where no straight line has
+        IK: from anywhere but straight below it (a tool in the nest, or just out of it, must rise
+        straight). From the arm-to-bench pose to the far nest of a 4-nest row the line left the arm's
+        reach at waypoint 12 of 34, though the nest itself is reachable; the contact watch still stops a
+        joint-space move that touches anything."""
+        joints = run.read(lambda hardware: dict(hardware.joint_positions()))
+        tool = self.behaviours.tool_pose(arm, joints)[:3, 3]
+        return float(np.hypot(*(tool[:2] - T_base_target[:2, 3]))) > LINE_ONLY_RADIUS_M
+
+    def __call__(self, run: GoalRun, goal: Any) -> dict:
+        arm = self.behaviours.arm_of(goal.arm)
+        try:
+            station = self.world.station(goal.station)
+        except KeyError:
+            names = ", ".join(s.name for s in self.world.stations)
+            raise ActionAbort(
+                ErrorCodes.UNKNOWN_STATION, f"unknown station {goal.station!r}: known are {names}"
+            ) from None
+        if goal.target not in TARGETS:
+            raise ActionAbort(
+                ErrorCodes.BAD_GOAL, f"unknown target {goal.target!r}: use {' or '.join(TARGETS)}"
+            )
+        sub_position = int(goal.sub_position)
+        if not 1 <= sub_position <= station.sub_positions:
+            raise ActionAbort(
+                ErrorCodes.BAD_GOAL,
+                f"station {station.name} has sub-positions 1..{station.sub_positions}, not {sub_position}",
+            )
+        if goal.target == "work_pose":  # final approach of the base, guided by the marker
+            bench = self.behaviours.motions.frames_for("Benchtop", arm)[0]
+            posture = {name: value for name, value in bench.items() if not name.startswith("arm_")}
+            T_world_work = working_pose(station, sub_position, arm)
+            sighting = align_base(
+                run, station, self.kinematics, lambda r: self.look(r, station.name), posture, T_world_work
+            )
+            return {"marker_in_base": pose_msg(sighting.T_base_marker)}
+        sighting = self._cached(run, station.name)
+        if sighting is None:
+            sighting = self.look(run, station.name)
+        marker_in_base = pose_msg(sighting.T_base_marker)
+        T_marker_site = (
+            station.T_marker_site(sub_position)
+            if goal.target == "site"
+            else station.T_marker_site_approach(sub_position)
+        )
+        seed = run.read(lambda hardware: dict(hardware.joint_positions()))
+        # Nests sit on level benches and the base stands on the floor, so the nest frame is levelled:
+        # a marker glued 1.4 deg askew in its plane tilted the perceived nest by as much, and together
+        # with the height it shifts put a finger tip into the bench ("nothing between the fingers").
+        # Heading and position still come from the marker.
+        # The marker's tilt comes from the level bench, not the image (perception.site_frames.upright_marker).
+        # The height is the bench's (world file), not the sighting's (perception.site_frames.at_height).
+        height = float((station.T_world_marker() @ T_marker_site)[2, 3])
+        T_base_site = nest_in_base(sighting.T_base_marker, station.T_table_marker(), T_marker_site, height)
+        releasing = goal.target == "site" and self.behaviours.holding.get(arm, False)
+        if releasing:  # where the plate hangs, seen with the nest's marker: shift the tool to centre it
+            T_base_site = self._centred_on_plate(run, arm, T_base_site, sighting)
+        T_base_grasp = T_base_site @ self.grasp.T_slot_grasp(approach=False, releasing=releasing)
+        T_base_target = self.behaviours.grasp_twin(arm, T_base_grasp, seed)
+        in_nest = goal.target == "site"  # slow only where the plate enters or leaves the nest
+        speed = TOOL_SPEED_INTO_POCKET if in_nest else TOOL_SPEED_FREE
+        # From the hotel (PutLabware): straight up to the carry height, then straight to the bench.
+        # The sighting taken at the end of the final approach stays valid: the base has not moved.
+        first = 0.1 if in_nest else max(0.1, self.behaviours.leave_hotel(run, arm))
+        try:
+            if in_nest:
+                self.behaviours.into_pocket(run, arm, T_base_target, (first, 1.0))
+                return {"marker_in_base": marker_in_base}
+            try:
+                self.behaviours.straight_move(run, arm, T_base_target, speed, (first, 1.0))
+            except ActionAbort as abort:
+                if abort.code != ErrorCodes.IK_FAILED or not self._may_leave_the_line(
+                    run, arm, T_base_target
+                ):
+                    raise
+                self.behaviours.joint_space_move(run, arm, T_base_target, (first, 1.0))
+        except ActionAbort as abort:
+            abort.extra = {"marker_in_base": marker_in_base}
+            raise
+        return {"marker_in_base": marker_in_base}

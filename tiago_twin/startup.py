@@ -1,0 +1,149 @@
+"""Start the digital twin: the simulated TIAGo++ and the robot's skills on one ROS 2 node.
+
+    python -m tiago_twin --world FILE [--seed N] [--realtime-factor-cap X]
+        [--idle-realtime-factor X] [--disturbance-seed N] ...
+
+Why one module: it is the one place that knows both sides. The simulator (tiago_sim.sim_node)
+plays the hardware and the vendor's stack and offers the hardware port; the skills
+(tiago_skills.skills_node) get that port and nothing else. A real TIAGo++ runs the same skills
+with an adapter on its own ROS 2 interfaces in place of the simulator.
+Threads: the sim thread owns PyBullet; a MultiThreadedExecutor spins the node on the main thread.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from rclpy.executors import MultiThreadedExecutor
+from rclpy.node import Node
+
+from lab_description.world import DEFAULT_WORLD, World, WorldError, load_world
+from tiago_description.motion_library import DEFAULT_MOTIONS_FILE
+from tiago_sim.measuring.run_recorder import RunRecorder
+from tiago_sim.node_main import spin_node
+from tiago_sim.sim_node.hardware import SimulatedHardware
+from tiago_sim.sim_node.navigation import Navigation
+from tiago_sim.sim_node.node import SimNode, make_simulation, robot_world
+from tiago_sim.sim_node.sim_thread import SimThread
+from tiago_skills.perception.aruco import detect_marker, draw_detection
+from tiago_skills.skills_node import RobotSkills
+from tiago_twin.lab_reset import LabReset
+
+log = logging.getLogger("tiago_twin")
+
+INVALID_WORLD_EXIT_CODE = 2
+"""Exit code for a world file that does not validate; the reason is the last line on stderr."""
+
+
+def outline_marker(world: World) -> Callable[[np.ndarray, np.ndarray, Any], np.ndarray]:
+    """A recorded head frame with the first station marker the robot's detector finds outlined."""
+
+    def annotate(rgb: np.ndarray, depth: np.ndarray, intrinsics: Any) -> np.ndarray:
+        for station in world.stations:
+            observation = detect_marker(rgb, intrinsics, station.marker_id, station.marker_size, depth)
+            if observation is not None:
+                return draw_detection(rgb, observation, intrinsics)
+        return rgb
+
+    return annotate
+
+
+def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(prog="python -m tiago_twin", description=__doc__.split("\n")[0])
+    parser.add_argument("--world", type=Path, default=DEFAULT_WORLD, help="world YAML (default: %(default)s)")
+    parser.add_argument("--seed", type=int, default=None, help="seed for odometry noise and IK restarts")
+    parser.add_argument(
+        "--realtime-factor-cap",
+        type=float,
+        default=None,
+        help="at most this many times real time (default: none)",
+    )
+    parser.add_argument(
+        "--idle-realtime-factor",
+        type=float,
+        default=1.0,
+        help="times real time while no motion runs (default: %(default)s)",
+    )
+    parser.add_argument("--motions", type=Path, default=DEFAULT_MOTIONS_FILE, help="keyframe motions YAML")
+    parser.add_argument(
+        "--disturbance-seed", type=int, default=None, help="seed of tiago_sim.measuring.disturbances"
+    )
+    parser.add_argument("--disturbance-levels", default="", help="DisturbanceLevels JSON")
+    parser.add_argument("--record-dir", type=Path, default=None, help="save camera frames here")
+    parser.add_argument("--log-level", default="INFO")
+    parser.add_argument(
+        "--near-misses",
+        action="store_true",
+        help="log robot parts passing within 1 cm of the lab (measuring)",
+    )
+    return parser.parse_args(argv)
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parse_args(argv)
+    logging.basicConfig(level=args.log_level, format="%(asctime)s %(levelname)s %(name)s: %(message)s")
+    try:
+        world = load_world(args.world)
+    except WorldError as error:
+        # One line (a problem per line otherwise) that a parent process can show as it is.
+        sys.stderr.write(f"invalid world file: {'; '.join(error.problems)}\n")
+        return INVALID_WORLD_EXIT_CODE
+    from tiago_sim.physics.simulation import (
+        Simulation,  # heavy import (PyBullet), only in the process that owns it
+    )
+
+    def simulation() -> Any:
+        sim = make_simulation(Simulation, world, args)
+        if args.record_dir is not None:
+            RunRecorder(sim, world, args.record_dir, annotate=outline_marker(world))
+        return sim
+
+    sim_thread = SimThread(
+        simulation,
+        realtime_factor_cap=args.realtime_factor_cap,
+        idle_realtime_factor=args.idle_realtime_factor,
+    )
+
+    built: list[SimNode] = []
+
+    def build(node: Node) -> SimNode:
+        sim_thread.start()
+        believed = robot_world(world, args)
+        navigation = Navigation(node, believed, sim_thread)
+        skills = RobotSkills(
+            node,
+            believed,
+            SimulatedHardware(sim_thread, navigation),
+            args.motions,
+            seed=args.seed if args.seed is not None else args.disturbance_seed,
+            motion_time=lambda: sim_thread.busy_sim_s,
+        )
+        sim_node = SimNode(
+            node,
+            believed,
+            sim_thread,
+            navigation=navigation,
+            pois=skills.current_pois,
+            activity=skills.actions.activity.snapshot,
+            activity_signature=skills.actions.activity.signature,
+        )
+        built.append(sim_node)
+        lab_reset = LabReset(node, sim_thread, skills.actions.slot)
+        lab_reset.hooks += [sim_node.forget_the_old_lab, skills.forget]
+        log.info("sim node ready: world %s, %d stations", world.source, len(world.stations))
+        return sim_node
+
+    def shut_down() -> None:
+        sim_thread.stop()
+        for sim_node in built:  # what localisation cost the sim thread, beside its own figures
+            sim_node.localisation.log_cost()
+
+    return spin_node(
+        "tiago_sim", lambda: MultiThreadedExecutor(num_threads=8), build, before_shutdown=shut_down
+    )
