@@ -7,6 +7,8 @@ tests that grasp and place without the ROS node plan exactly what the skills wou
 
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 
 from robot_port.types import ARM_SIDES, JointTrajectory
@@ -17,7 +19,8 @@ from tiago_skills.tool_path import STRAIGHT_STEP, plan_tool_path
 
 TOOL_SPEED = 0.08  # m/s, the skills' speed into a pocket
 KINEMATICS = RobotKinematics()  # the robot model the skills plan with
-_RNG = np.random.default_rng(0)
+# IK restart seeds per Simulation, so a test's moves do not depend on the tests run before it
+_RNGS: weakref.WeakKeyDictionary[Simulation, np.random.Generator] = weakref.WeakKeyDictionary()
 
 
 def move_tool(
@@ -31,8 +34,9 @@ def move_tool(
     """Grasping frame of ``arm`` to a pose in base_footprint (straight when asked), started on `sim`."""
     if arm not in ARM_SIDES:
         return FailedMotion("move_tool", "BAD_GOAL", f"unknown arm {arm!r}")
+    rng = _RNGS.setdefault(sim, np.random.default_rng(0))
     planned = plan_tool_path(
-        KINEMATICS, _RNG, arm, sim.joint_positions(), T_base_grasp, straight_line, use_torso
+        KINEMATICS, rng, arm, sim.joint_positions(), T_base_grasp, straight_line, use_torso
     )
     if isinstance(planned, str):
         return FailedMotion("move_tool", "IK_FAILED", planned)
