@@ -44,6 +44,32 @@ FAULT_CODES = frozenset(
 ExecuteFn = Callable[[GoalRun, Any], dict]
 
 
+# The base's odometry and its pose in the map as believed (x, y, yaw each), and every joint's
+# reading, at one instant.
+Readings = tuple[tuple[float, ...], tuple[float, ...], dict[str, float]]
+MOVED_BY = 1e-4  # rad or m: a joint that changed less than this over a goal is left out of its line
+
+
+def describe_motion(before: Readings | None, after: Readings | None) -> str:
+    """The base's poses and the joints that changed, at a goal's start and end, as one log line.
+
+    Why: a step's least possible time under the robot's limits depends on what it moved, not on
+    its name; this line is the record of that (tiago_sim.measuring.time_budget reads it)."""
+    if before is None or after is None:
+        return "no readings"
+    (odometry0, map0, joints0), (odometry1, map1, joints1) = before, after
+    moved = [
+        f"{name} {joints0[name]:.4f}>{joints1[name]:.4f}"
+        for name in sorted(joints0.keys() & joints1.keys())
+        if abs(joints1[name] - joints0[name]) >= MOVED_BY
+    ]
+    odometry, believed = (
+        " -> ".join("({:.4f}, {:.4f}, {:.4f})".format(*pose) for pose in poses)
+        for poses in ((odometry0, odometry1), (map0, map1))
+    )
+    return f"odometry {odometry}; map {believed}; joints {', '.join(moved) or 'none'}"
+
+
 class RobotActivity:
     """What the robot is doing, for /robot_state (written by goals, read by the publisher).
 
@@ -144,6 +170,7 @@ class RobotActionServers:
             result = action_type.Result()
             acquired = False
             sim_started, busy_started = self._now(), self.motion_time()
+            before = self._readings()
             try:
                 self.slot.acquire(name)
                 acquired = True
@@ -168,6 +195,8 @@ class RobotActionServers:
                 if acquired:
                     self.activity.state = ""
                     self.slot.release()
+                # what the goal moved, read through the port (tiago_sim.measuring.time_budget's minima)
+                log.info("%s moved: %s", name, describe_motion(before, self._readings()))
                 # one line per goal with its simulated span (tiago_sim.measuring.benchmark times phases by it)
                 log.info(
                     "%s %s: sim %.3f .. %.3f s, %.3f s of it with no motion running",
@@ -183,6 +212,17 @@ class RobotActionServers:
             return float(self.hardware.now())
         except Exception:  # noqa: BLE001 - a log line's figure, never a goal's end
             return float("nan")
+
+    def _readings(self) -> Readings | None:
+        try:
+            hardware = self.hardware
+            return (
+                tuple(hardware.odometry()),
+                tuple(hardware.pose_estimate()),
+                dict(hardware.joint_positions()),
+            )
+        except Exception:  # noqa: BLE001 - a log line's figures, never a goal's end
+            return None
 
     @staticmethod
     def _fill_failure(result: Any, code: str, message: str, extra: dict | None) -> None:
