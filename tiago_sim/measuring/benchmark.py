@@ -1,13 +1,15 @@
 """Benchmark: one plate transfer A -> B through the ROS actions, timed.
 
     python -m tiago_sim.measuring.benchmark [--world FILE] [--seed N] [--from station_a] [--to station_b]
+                                            [--budget]
 
-Starts sim_node and sequencer as child processes (own ROS domain unless ROS_DOMAIN_ID is set),
-runs GetLabware at the source and PutLabware at the destination, and prints simulated and wall
-time, the real-time factor, sim and wall time per task phase (phase changes from the task
-feedback, sim time from the robot goals' spans in the sim node's log), the placement error and the marker
-pose error against ground truth, with the targets of issue 5 beside them. Ground truth (the
-world file and the /check_placement service) is used here only to measure.
+Starts the robot side (tiago_twin) and the sequencer as child processes (own ROS domain unless
+ROS_DOMAIN_ID is set), runs GetLabware at the source and PutLabware at the destination, and prints
+simulated and wall time, the real-time factor, sim and wall time per task phase (phase changes from
+the task feedback, sim time from the robot goals' spans in the robot side's log), the placement
+error and the marker pose error against ground truth, with the targets of issue 5 beside them.
+Ground truth (the world file and the /check_placement service) is used here only to measure. With
+--budget, each step's time against the least time the robot's limits allow (time_budget).
 """
 
 from __future__ import annotations
@@ -29,10 +31,11 @@ from typing import Any
 # Targets of issue 5 (printed beside the figures; tests never assert time).
 TARGET_SIM_S = 60.0
 TARGET_REALTIME_FACTOR = 10.0
+ROBOT_LOG = "tiago_twin.log"  # the robot side's log: _start names it after the module it runs
 
 
 _NO_GOAL = {"starting", "done", "result"}  # task phases during which no robot goal runs
-_GOAL_LINE = re.compile(
+GOAL_LINE = re.compile(
     r"tiago_skills\.action_servers: (/\w+) \S+: "
     r"sim ([\d.]+) \.\. ([\d.]+) s, ([\d.-]+) s of it with no motion"
 )
@@ -40,10 +43,10 @@ _GOAL_LINE = re.compile(
 
 def _goal_spans(log_path: Path) -> list[tuple[str, float, float, float]]:
     """(action, sim start, sim end, sim seconds without motion) of every robot goal, in order, from
-    the sim node's log."""
+    the robot side's log."""
     spans = []
     for line in log_path.read_text().splitlines():
-        match = _GOAL_LINE.search(line)
+        match = GOAL_LINE.search(line)
         if match:
             spans.append((match[1], float(match[2]), float(match[3]), float(match[4])))
     return spans
@@ -71,6 +74,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--from", dest="source", default="station_a")
     parser.add_argument("--to", dest="destination", default="station_b")
+    parser.add_argument(
+        "--budget", action="store_true", help="then print each step's time against its minimum (time_budget)"
+    )
     args = parser.parse_args(argv)
     os.environ.setdefault("ROS_DOMAIN_ID", str(random.SystemRandom().randint(150, 200)))
     os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
@@ -95,9 +101,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     world_args = ["--world", str(args.world or DEFAULT_WORLD)]
     log_dir = Path(tempfile.mkdtemp(prefix="tiago_benchmark_"))
-    sim = _start(
-        "tiago_twin", [*world_args, "--seed", str(args.seed), "--log-level", "INFO"], log_dir
-    )
+    sim = _start("tiago_twin", [*world_args, "--seed", str(args.seed), "--log-level", "INFO"], log_dir)
     sequencer = _start("tiago_sim.sequencer", world_args, log_dir)
     rclpy.init()
     node = rclpy.create_node("tiago_benchmark")
@@ -156,7 +160,7 @@ def main(argv: list[str] | None = None) -> int:
             truth[station] = truth.get("now")
         wall_end = boundaries[-1][1]
         wall_s = wall_end - wall_start
-        goals = _goal_spans(log_dir / "sim_node.log")
+        goals = _goal_spans(log_dir / ROBOT_LOG)
         phases = [(phase, t0) for phase, t0 in boundaries if phase.split(": ", 1)[1] not in _NO_GOAL]
         if len(goals) != len(phases):
             print(f"warning: {len(goals)} robot goals, {len(phases)} task phases: phase sim times are off")
@@ -185,7 +189,12 @@ def main(argv: list[str] | None = None) -> int:
             print(f"  {phase:<32} {phase_sim:7.2f} {phase_wall:7.2f}")
         print(f"placement: in_nest={check.in_nest} error {check.position_error_m * 1000:.2f} mm, "
               f"yaw {math.degrees(check.yaw_error_rad):.2f} deg")  # fmt: skip
-        _marker_errors(log_dir / "sim_node.log", world, truth, np, tf)
+        _marker_errors(log_dir / ROBOT_LOG, world, truth, np, tf)
+        if args.budget:
+            from tiago_sim.measuring.time_budget import report
+
+            print(f"where the time went (logs in {log_dir}):")
+            print(report(log_dir))
     finally:
         executor.shutdown()
         node.destroy_node()
@@ -196,7 +205,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _marker_errors(log_path: Path, world: Any, truth: dict[str, Any], np: Any, tf: Any) -> None:
-    """Marker positions the robot perceived (sim_node log) against ground truth.
+    """Marker positions the robot perceived (the robot side's log) against ground truth.
 
     Truth: the marker pose from the world file seen from the true base pose that the sim node
     publishes on /ground_truth/base_pose (taken while the base stood at the station). The sighting

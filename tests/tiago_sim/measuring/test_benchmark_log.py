@@ -22,7 +22,7 @@ PREFIX = "2026-11-23 17:10:19,711 INFO "
 
 
 def _write(tmp_path: Path, lines: list[str]) -> Path:
-    path = tmp_path / "sim_node.log"
+    path = tmp_path / benchmark.ROBOT_LOG
     path.write_text("".join(PREFIX + line + "\n" for line in lines))
     return path
 
