@@ -69,8 +69,8 @@ def drive_min_s(
     The length as one profile from rest to rest at the linear speed and acceleration limits, the
     turns (onto each segment, then onto the end heading) as one at the angular limits, and the
     longer of the two: the base may turn while it drives, each axis within its own limits (the
-    drive controller keeps to 80 % of them and turns on the spot before a sharp corner). A segment
-    may be driven backwards where that turns less (undocking does)."""
+    path following drives each segment from rest to rest at 80 % of them and turns on the spot at
+    the corners). A segment may be driven backwards where that turns less (undocking does)."""
     legs = list(_legs(path, start_yaw))
     heading = start_yaw + sum(turn for _, turn in legs)
     turned = sum(abs(turn) for _, turn in legs) + abs(wrap_angle(end_yaw - heading))
