@@ -8,6 +8,9 @@ worker index) and so its own robot
 side; a trial's seed alone decides its disturbances and layout, whichever worker runs it.
 Workers are spawned (not forked: the parent may hold threads and DDS state). Ctrl-C or SIGTERM:
 the running trials are abandoned, each worker stops its deployment, the trials done are returned.
+A worker that dies (a crash in a native library) breaks its pool: the trials running then are
+recorded as failed ("other", naming the lost worker), never re-run, and the trials not yet
+started go on in a fresh pool, so one crash costs the trials it hit, not the campaign.
 
 Threads: the caller's thread (the CLI's main thread) in the parent; each worker's main thread.
 """
@@ -19,9 +22,12 @@ import multiprocessing
 import os
 import signal
 import sys
+import tempfile
 from collections.abc import Callable
 from concurrent.futures import Future, ProcessPoolExecutor, as_completed
-from typing import TextIO
+from concurrent.futures.process import BrokenProcessPool
+from pathlib import Path
+from typing import Any, TextIO
 
 from sila_labware.benchmarks.campaign import (
     CampaignOptions,
@@ -35,13 +41,14 @@ from sila_labware.benchmarks.campaign import (
 logger = logging.getLogger(__name__)
 
 _worker_index = 0  # in a worker process: its index, which sets its ports and ROS domain
+_started_dir = ""  # in a worker process: where it notes each trial it starts (a file per seed)
 
 
-def _start_worker(indices: multiprocessing.Queue, levels: dict[str, int]) -> None:
+def _start_worker(indices: multiprocessing.Queue, levels: dict[str, int], started_dir: str) -> None:
     """A worker's set-up: its index; a ROS domain of its own; logging as the parent's; signals
     unwind the running trial."""
-    global _worker_index
-    _worker_index = indices.get()
+    global _worker_index, _started_dir
+    _worker_index, _started_dir = indices.get(), started_dir
     # The parent's ROS_DOMAIN_ID would put every worker in one domain: without --domain-id each
     # worker reserves its own (ros_bridge.domain: a lock per id, held while the worker lives).
     os.environ.pop("ROS_DOMAIN_ID", None)
@@ -60,28 +67,73 @@ def _run_in_worker(options: CampaignOptions, trial_seed: int, record: bool) -> T
     return run_trial(options, trial_seed, options.record_dir if record else None, worker=_worker_index)
 
 
+def _noted(trial: Callable[..., TrialOutcome], options: CampaignOptions, seed: int, record: bool) -> Any:
+    """Note on disk that this trial started (it outlives a worker that dies), then run it."""
+    (Path(_started_dir) / str(seed)).touch()
+    return trial(options, seed, record)
+
+
+def lost_trial(trial_seed: int, why: str) -> TrialOutcome:
+    """The outcome of a trial whose worker died under it: a failure of cause "other"."""
+    return TrialOutcome(
+        seed=trial_seed,
+        success=False,
+        cause="other",
+        error=f"worker lost: {why}",
+        sim_seconds=0.0,
+        wall_seconds=0.0,
+        startup_wall_seconds=0.0,
+        plate_position_error_mm=None,
+    )
+
+
 def run_parallel_campaign(
     options: CampaignOptions,
     progress_stream: TextIO | None = sys.stderr,
     on_trial: Callable[[TrialOutcome], None] | None = None,
+    trial: Callable[[CampaignOptions, int, bool], TrialOutcome] = _run_in_worker,
 ) -> list[TrialOutcome]:
-    """The campaign's trials on `options.jobs` workers; outcomes sorted by seed (fewer if stopped)."""
+    """The campaign's trials on `options.jobs` workers; outcomes sorted by seed (fewer if stopped).
+    `trial` runs one trial in a worker (a module-level function, for the spawned workers)."""
+    progress = CampaignProgress(progress_stream, options.trials)
+    outcomes: list[TrialOutcome] = []
+    levels = {name: logging.getLogger(name or None).getEffectiveLevel() for name in ("", "sila_labware")}
+    waiting = [options.seed + index for index in range(options.trials)]
+    while waiting:
+        waiting = _run_pool(options, waiting, levels, progress, outcomes, on_trial, trial)
+    return sorted(outcomes, key=lambda outcome: outcome.seed)
+
+
+def _run_pool(
+    options: CampaignOptions,
+    seeds: list[int],
+    levels: dict[str, int],
+    progress: CampaignProgress,
+    outcomes: list[TrialOutcome],
+    on_trial: Callable[[TrialOutcome], None] | None,
+    trial: Callable[[CampaignOptions, int, bool], Any],
+) -> list[int]:
+    """Run `seeds` on a fresh pool; the seeds not started when a worker died (else none)."""
     context = multiprocessing.get_context("spawn")
     indices = context.Queue()
     for index in range(options.jobs):
         indices.put(index)
-    progress = CampaignProgress(progress_stream, options.trials)
-    outcomes: list[TrialOutcome] = []
-    levels = {name: logging.getLogger(name or None).getEffectiveLevel() for name in ("", "sila_labware")}
-    pool = ProcessPoolExecutor(options.jobs, context, initializer=_start_worker, initargs=(indices, levels))
+    started = tempfile.TemporaryDirectory(prefix="bench_started_")
+    pool = ProcessPoolExecutor(
+        options.jobs, context, initializer=_start_worker, initargs=(indices, levels, started.name)
+    )
     futures: dict[Future[TrialOutcome], int] = {
-        pool.submit(_run_in_worker, options, options.seed + index, index == 0): options.seed + index
-        for index in range(options.trials)
+        pool.submit(_noted, trial, options, seed, seed == options.seed): seed for seed in seeds
     }
+    flags = replay_flags(options)
     try:
         for future in as_completed(futures):
-            outcome = future.result()  # a worker's KeyboardInterrupt arrives here as one too
-            record_outcome(outcome, outcomes, progress, on_trial, replay_flags(options))
+            try:
+                outcome = future.result()  # a worker's KeyboardInterrupt arrives here as one too
+            except BrokenProcessPool as broken:
+                begun = {int(path.name) for path in Path(started.name).iterdir()}
+                return _after_a_lost_worker(futures, begun, broken, outcomes, progress, on_trial, flags)
+            record_outcome(outcome, outcomes, progress, on_trial, flags)
     except KeyboardInterrupt:
         logger.warning(
             "interrupted: %d of %d trial(s) done; stopping the workers", len(outcomes), options.trials
@@ -92,4 +144,31 @@ def run_parallel_campaign(
             os.kill(child.pid, signal.SIGINT)
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
-    return sorted(outcomes, key=lambda outcome: outcome.seed)
+        started.cleanup()
+    return []
+
+
+def _after_a_lost_worker(
+    futures: dict[Future[TrialOutcome], int],
+    begun: set[int],
+    broken: BrokenProcessPool,
+    outcomes: list[TrialOutcome],
+    progress: CampaignProgress,
+    on_trial: Callable[[TrialOutcome], None] | None,
+    flags: str,
+) -> list[int]:
+    """A worker died: the trials that had begun fail (which of them crashed its worker cannot be
+    told), those finished count, the rest wait for a fresh pool."""
+    done = {outcome.seed for outcome in outcomes}
+    waiting = []
+    for future, seed in futures.items():
+        if seed in done:
+            continue
+        if future.done() and not future.cancelled() and future.exception() is None:
+            record_outcome(future.result(), outcomes, progress, on_trial, flags)
+        elif seed in begun:
+            record_outcome(lost_trial(seed, str(broken)), outcomes, progress, on_trial, flags)
+        else:
+            waiting.append(seed)
+    logger.warning("a worker died (%s): %d trial(s) go on in a fresh pool", broken, len(waiting))
+    return sorted(waiting)
