@@ -25,7 +25,7 @@ from tiago_description.kinematics import RobotKinematics
 from tiago_description.motion_library import HOTEL_MOTIONS, MotionLibrary
 from tiago_description.transforms import make_transform
 from tiago_skills.goal_run import ActionAbort, GoalRun
-from tiago_skills.tool_path import STRAIGHT_STEP, plan_tool_path
+from tiago_skills.tool_path import plan_tool_path, tool_trajectory
 
 log = logging.getLogger(__name__)
 
@@ -278,8 +278,7 @@ class RobotBehaviours:
             planned = plan_tool_path(self._kinematics, self._rng, arm, current, T_base_grasp, True, use_torso)
         if isinstance(planned, str):
             raise ActionAbort(ErrorCodes.IK_FAILED, planned)
-        segment_s = STRAIGHT_STEP / max(tool_speed, 1e-3)
-        return JointTrajectory(tuple(planned), 1.0, min_segment_s=segment_s, name="move_tool")
+        return tool_trajectory(planned, tool_speed)
 
     def joint_space_move(
         self, run: GoalRun, arm: str, T_base_grasp: np.ndarray, span: tuple[float, float]

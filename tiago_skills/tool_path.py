@@ -1,7 +1,7 @@
 """Joint waypoints that move a grasping frame along a straight line (or straight to a pose), by IK.
 
 Why apart from the Simulation: this is pure kinematics on the robot model (pinocchio), no
-physics; the Simulation turns the waypoints into a timed joint trajectory. Safe on any thread
+physics; the robot's joint-trajectory controllers time the waypoints (tool_trajectory). Safe on any thread
 that owns the RobotKinematics it is given.
 """
 
@@ -12,6 +12,7 @@ import math
 import numpy as np
 import pinocchio as pin
 
+from robot_port.types import JointTrajectory
 from tiago_description import transforms as tf
 from tiago_description.kinematics import RobotKinematics
 
@@ -59,6 +60,15 @@ def plan_tool_path(
         solutions.append(result.joint_positions)
         seed.update(result.joint_positions)
     return solutions
+
+
+def tool_trajectory(
+    waypoints: list[dict[str, float]], tool_speed: float, straight_line: bool = True
+) -> JointTrajectory:
+    """The joint trajectory through planned waypoints: along a straight line one waypoint per
+    STRAIGHT_STEP, each segment no faster than `tool_speed` (m/s) moves the tool."""
+    segment_s = STRAIGHT_STEP / max(tool_speed, 1e-3) if straight_line else 0.0
+    return JointTrajectory(tuple(waypoints), 1.0, min_segment_s=segment_s, name="move_tool")
 
 
 def _creep(

@@ -11,11 +11,11 @@ import weakref
 
 import numpy as np
 
-from robot_port.types import ARM_SIDES, JointTrajectory
+from robot_port.types import ARM_SIDES
 from tiago_description.kinematics import RobotKinematics
 from tiago_sim.physics.motion import FailedMotion, Motion
 from tiago_sim.physics.simulation import Simulation
-from tiago_skills.tool_path import STRAIGHT_STEP, plan_tool_path
+from tiago_skills.tool_path import plan_tool_path, tool_trajectory
 
 TOOL_SPEED = 0.08  # m/s, the skills' speed into a pocket
 KINEMATICS = RobotKinematics()  # the robot model the skills plan with
@@ -40,5 +40,4 @@ def move_tool(
     )
     if isinstance(planned, str):
         return FailedMotion("move_tool", "IK_FAILED", planned)
-    segment_s = STRAIGHT_STEP / max(tool_speed, 1e-3) if straight_line else 0.0
-    return sim.execute_trajectory(JointTrajectory(tuple(planned), 1.0, segment_s, "move_tool"))
+    return sim.execute_trajectory(tool_trajectory(planned, tool_speed, straight_line))
