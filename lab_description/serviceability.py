@@ -25,6 +25,8 @@ Pure computation (pinocchio, numpy); safe on any thread that owns its own `Robot
 
 from __future__ import annotations
 
+import dataclasses
+import logging
 import math
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -32,11 +34,14 @@ from functools import lru_cache
 
 import numpy as np
 
+from lab_description import station_placement as placement
 from tiago_description import robot_model
 from tiago_description import transforms as tf
 from tiago_description.hotel_model import hotel_sweep_radius
 from tiago_description.kinematics import CAMERA_FRAME, RobotKinematics, head_angles_towards
 from tiago_description.motion_library import HotelGrasp, load_motions
+
+log = logging.getLogger(__name__)
 
 BASE_RADIUS = robot_model.BASE_RADIUS
 HOTEL_SWEEP_RADIUS = hotel_sweep_radius()
@@ -57,7 +62,7 @@ WORKING_CLEARANCE = HOTEL_SWEEP_RADIUS + ALIGN_SIGHTING_ERROR + ALIGN_DRIVE_OVER
 approach sweeps in part (it drives at the bearing to the working pose, then turns to the bench), plus
 where that approach may end: with the circle taken as 0.35 m and no margin, a working pose 0.361 m
 from its bench let the tray touch it (the base ended 12 mm nearer than its working pose)."""
-REACH_ARM = "right"
+REACH_ARM = placement.REACH_ARM
 LOOK_TORSO_LIFT = 0.15
 """The torso height of "Travel", where the first look at a station's marker is taken (m)."""
 CAMERA_FOCAL_PX = 522.2
@@ -89,6 +94,53 @@ def _robot() -> tuple[RobotKinematics, HotelGrasp, dict[str, float]]:
     for frame in motions.frames_for("Benchtop", REACH_ARM):
         seed.update(frame)
     return RobotKinematics(), motions.hotel, seed
+
+
+def place_station(station, tallest_labware_m: float, *, reach: bool = True):  # noqa: ANN001, ANN201 - Station
+    """The station with what its world file left to the robot chosen (`station_placement`): the
+    working distance from the bench's front edge, the POI behind it, the row centred in the right
+    arm's band, and (`reach`) the highest approach height from which the arm reaches every nest."""
+    given = station.placement_from_file
+    changes: dict[str, float] = {}
+    if "work_standoff" not in given:
+        changes["work_standoff"] = (
+            station.standoff
+            if "standoff" in given
+            else placement.least_working_distance(station, WORKING_CLEARANCE)
+        )
+    if "standoff" not in given:
+        changes["standoff"] = round(
+            changes.get("work_standoff", station.work_standoff) + placement.FINAL_APPROACH_M, 3
+        )
+    if "lateral" not in given:
+        changes["lateral"] = placement.centred_lateral(station)
+    if "approach_height" not in given:
+        changes["approach_height"] = placement.PREFERRED_APPROACH_HEIGHT_M
+    placed = dataclasses.replace(station, **changes)
+    if reach and "approach_height" not in given:
+        placed = _highest_reachable_approach(placed, tallest_labware_m)
+    return placed
+
+
+def _highest_reachable_approach(station, tallest_labware_m: float):  # noqa: ANN001, ANN202
+    """The station with the highest of `approach_heights` from which every nest is reached, found by
+    bisection (reach only shrinks as the approach rises); the least of them if none is (the reach
+    check then refuses the station, naming it)."""
+    heights = placement.approach_heights(tallest_labware_m)  # highest first
+
+    def reached(index: int) -> bool:
+        return not _reach_problems(dataclasses.replace(station, approach_height=heights[index]))
+
+    if reached(0):
+        return dataclasses.replace(station, approach_height=heights[0])
+    low, high = 0, len(heights) - 1  # heights[low] is not reached; find the first that is
+    if not reached(high):
+        return dataclasses.replace(station, approach_height=heights[high])
+    while high - low > 1:
+        middle = (low + high) // 2
+        low, high = (low, middle) if reached(middle) else (middle, high)
+    log.info("%s: approach height %.2f m, the highest the arm reaches", station.name, heights[high])
+    return dataclasses.replace(station, approach_height=heights[high])
 
 
 def service_problems(world) -> list[ServiceProblem]:  # noqa: ANN001 - a lab.world.World (no import cycle)
@@ -164,27 +216,37 @@ def _clear(label: str, pose, radius: float, station) -> Iterator[str]:  # noqa: 
         )
 
 
+def working_poses(station) -> list[tuple[str, object]]:  # noqa: ANN001
+    """The station's working pose and every other pose a nest is worked at from (`nest_working_pose`),
+    each with how the messages name it."""
+    working = station.aligned_pose()
+    poses: list[tuple[str, object]] = [("the working pose", working)]
+    for sub_position, T_world_base in placement.nest_working_poses(station):
+        x, y, yaw = float(T_world_base[0, 3]), float(T_world_base[1, 3]), working.yaw
+        if math.hypot(x - working.x, y - working.y) > 1e-6:
+            poses.append((f"the working pose for nest {sub_position}", type(working)(x, y, yaw)))
+    return poses
+
+
 def _station_problems(world, station) -> list[str]:  # noqa: ANN001
-    poi, working = station.work_pose(), station.aligned_pose()
+    poi = station.work_pose()
     problems: list[str] = []
     for other in world.stations:
         turning = HOTEL_SWEEP_RADIUS + TURN_MARGIN
         problems += _clear(f"{station.name!r}: the base at POI {station.poi}", poi, turning, other)
-        problems += _clear(
-            f"{station.name!r}: the base at the working pose", working, WORKING_CLEARANCE, other
-        )
-    problems += _reach_problems(station, working)
-    for label, pose in ((f"POI {station.poi}", poi), ("the working pose", working)):
+        for label, working in working_poses(station):
+            problems += _clear(f"{station.name!r}: the base at {label}", working, WORKING_CLEARANCE, other)
+    problems += _reach_problems(station)
+    for label, pose in ((f"POI {station.poi}", poi), *working_poses(station)):
         problems += _view_problems(station, label, pose)
     return problems
 
 
-def _reach_problems(station, working) -> list[str]:  # noqa: ANN001
+def _reach_problems(station) -> list[str]:  # noqa: ANN001
     kinematics, grasp, seed = _robot()
-    T_base_world = tf.invert(working.matrix())
     problems = []
-    for sub_position in range(1, station.sub_positions + 1):
-        T_base_site = tf.levelled(T_base_world @ station.T_world_site(sub_position))
+    for sub_position, T_world_base in placement.nest_working_poses(station):
+        T_base_site = tf.levelled(tf.invert(T_world_base) @ station.T_world_site(sub_position))
         heights = (("the grasp", 0.0), ("the approach", station.approach_height))
         for label, height in heights:
             T_base_grasp = T_base_site @ tf.make_transform((0.0, 0.0, height)) @ grasp.T_slot_grasp(False)
@@ -193,10 +255,48 @@ def _reach_problems(station, working) -> list[str]:  # noqa: ANN001
                 problems.append(
                     f"{station.name!r}: nest {sub_position} is out of the {REACH_ARM} arm's reach at "
                     f"any torso height ({label}, {height * 1000:.0f} mm above the nest: x {x:.3f} y {y:.3f} "
-                    f"z {z:.3f} m in the working pose's base_footprint)"
+                    f"z {z:.3f} m in the working pose's base_footprint); {_reach_advice(station, x, y, z)}"
                 )
                 break
     return problems
+
+
+def _reach_advice(station, x: float, y: float, z: float) -> str:  # noqa: ANN001
+    """What would make a nest at (x, y, z) in the working pose's base_footprint reachable: the highest
+    nest the arm reaches top-down this far ahead, and how near the front edge the base may stand."""
+    ceiling = top_down_ceiling(round(x, 2), round(y, 2), station.approach_height)
+    nearest = placement.least_working_distance(station, WORKING_CLEARANCE)
+    reach = (
+        f"from here the arm reaches a nest up to {math.floor(ceiling * 100) / 100:.2f} m above the floor"
+        if ceiling is not None
+        else "the arm reaches no nest there at any height"
+    )
+    return (
+        f"{reach}; lower the nest, or bring the row nearer the bench's front edge (the base may work "
+        f"as near as {nearest:.2f} m from this row, its front edge then {WORKING_CLEARANCE:.2f} m ahead)"
+    )
+
+
+@lru_cache(maxsize=256)
+def top_down_ceiling(x: float, y: float, approach_height: float) -> float | None:
+    """The highest nest (its floor above the floor, m) that the arm reaches top-down, grasp and approach,
+    at (x, y) in base_footprint; None if none from 0.3 m up. Bisection to 5 mm on the robot model."""
+    kinematics, grasp, seed = _robot()
+
+    def reached(z: float) -> bool:
+        site = tf.make_transform((x, y, z))
+        return all(
+            _reachable(kinematics, site @ tf.make_transform((0.0, 0.0, h)) @ grasp.T_slot_grasp(False), seed)
+            for h in (0.0, approach_height)
+        )
+
+    low, high = 0.3, 1.3
+    if not reached(low):
+        return None
+    while high - low > 0.005:
+        middle = (low + high) / 2
+        low, high = (middle, high) if reached(middle) else (low, middle)
+    return low
 
 
 def _reachable(kinematics: RobotKinematics, T_base_grasp: np.ndarray, seed: dict[str, float]) -> bool:

@@ -77,6 +77,7 @@ class Pose2D:
         return tf.from_planar(self.x, self.y, self.yaw, z)
 
 
+STATION_PLACEMENT_FIELDS = ("standoff", "work_standoff", "lateral", "approach_height")
 MARKER_BOARD_SCALE = 1.4
 """The marker's board is this many times the marker's side, square, standing on the bench top behind
 the marker (physics.scene builds it)."""
@@ -103,6 +104,9 @@ class Station:
     lateral: float  # and this far to the side, so the site lies on the working arm's side
     approach_height: float  # site_approach is this far above the site
     work_standoff: float = 0.0  # the marker-guided final approach ends this close (0: same as standoff)
+    placement_from_file: frozenset[str] = frozenset(STATION_PLACEMENT_FIELDS)
+    """Which of standoff, work_standoff, lateral and approach_height the world file set; the robot
+    chose the others (`lab_description.station_placement`)."""
 
     def nests(self) -> tuple[Nest, ...]:
         """Its nests, sub-position 1 first."""
@@ -215,7 +219,12 @@ def world_from_raw(raw: Any, source: str, default_name: str = "lab", *, check_ro
     model, problems = check(raw)
     if model is None:
         raise WorldError([problem.line(source) for problem in problems])
-    world = _world(model, source, default_name=default_name)
+    from lab_description.serviceability import place_station  # pinocchio: the robot model's reach
+
+    def place(station: Station, tallest: float) -> Station:
+        return place_station(station, tallest, reach=check_robot)
+
+    world = _world(model, source, default_name=default_name, place=place)
     placement = _bench_placement_problems(world) + _obstacle_placement_problems(world)
     if placement:
         raise WorldError([f"{source}: {where}: {what}" for where, what in placement])
@@ -270,16 +279,28 @@ def _radians(values: tuple[float, float, float]) -> tuple[float, float, float]:
     return (roll, pitch, yaw)
 
 
-def station_from_raw(raw: Any) -> Station | None:
-    """One station's mapping as the program reads it, or None if it breaks the schema; none of the
-    checks that need the rest of the lab (a layout generator's quick look at a candidate)."""
+def station_from_raw(raw: Any, tallest_labware_m: float) -> Station | None:
+    """One station's mapping as the program reads it, placed for labware up to `tallest_labware_m`
+    high (its approach height left unchecked against the arm's reach), or None if it breaks the
+    schema; none of the checks that need the rest of the lab (a layout generator's quick look)."""
     try:
-        return _station(schema.Station.model_validate(raw))
+        item = schema.Station.model_validate(raw)
     except ValueError:  # pydantic's ValidationError
         return None
+    from lab_description.serviceability import place_station
+
+    return place_station(_station(item), tallest_labware_m, reach=False)
 
 
 def _station(item: schema.Station) -> Station:
+    """The station as the file gives it; the placement fields it leaves out are 0 until placed."""
+    poi = item.poi
+    given = {
+        "standoff": poi.standoff,
+        "work_standoff": poi.work_standoff,
+        "lateral": poi.lateral,
+        "approach_height": item.nests.approach_height,
+    }
     return Station(
         name=item.name,
         table_pose=_pose(item.table.pose),
@@ -293,16 +314,18 @@ def _station(item: schema.Station) -> Station:
         sub_positions=item.nests.sub_positions,
         spacing=item.nests.spacing,
         nest_clearance=item.nests.clearance,
-        poi=item.poi.name,
-        standoff=item.poi.standoff,
-        lateral=item.poi.lateral,
-        approach_height=item.nests.approach_height,
-        work_standoff=item.poi.work_standoff or item.poi.standoff,
+        poi=poi.name or f"{item.name}_work",
+        standoff=poi.standoff or 0.0,
+        lateral=poi.lateral or 0.0,
+        approach_height=item.nests.approach_height or 0.0,
+        work_standoff=poi.work_standoff or poi.standoff or 0.0,
+        placement_from_file=frozenset(name for name, value in given.items() if value is not None),
     )
 
 
-def _world(model: schema.WorldFile, source: str, default_name: str) -> World:
-    """The validated file in the program's words: dataclasses, radians, the labware model."""
+def _world(model: schema.WorldFile, source: str, default_name: str, place: Any) -> World:
+    """The validated file in the program's words: dataclasses, radians, the labware model. `place`
+    chooses what the file leaves to the robot (station, tallest labware height -> Station)."""
     dock_pose = _pose(model.dock.pose)
     distance = model.dock.approach_distance
     pois = {
@@ -313,7 +336,8 @@ def _world(model: schema.WorldFile, source: str, default_name: str) -> World:
         ),
         **{name: _pose(pose) for name, pose in model.pois.items()},
     }
-    stations = tuple(_station(item) for item in model.stations)
+    tallest = max((t.height for t in model.labware_types.values()), default=0.0)
+    stations = tuple(place(_station(item), tallest) for item in model.stations)
     pois.update({station.poi: station.work_pose() for station in stations})
     plates: dict[Plate, Nest | HotelSlot] = {}
     for item in model.plates:

@@ -235,11 +235,12 @@ def _unique_names(raw: dict) -> list[Problem]:
             problems.append(Problem(f"stations[{i}].name", f"duplicate station name {name!r}"))
         if _is_index(marker_id) and marker_id in marker_ids:
             problems.append(Problem(f"stations[{i}].marker.id", f"marker id {marker_id} already used"))
-        if isinstance(poi.get("name"), str) and poi["name"] in poi_names:
-            problems.append(Problem(f"stations[{i}].poi.name", f"POI name {poi['name']!r} already used"))
+        poi_name = poi.get("name", f"{name}_work" if isinstance(name, str) else None)
+        if isinstance(poi_name, str) and poi_name in poi_names:
+            problems.append(Problem(f"stations[{i}].poi.name", f"POI name {poi_name!r} already used"))
         names.add(name if isinstance(name, str) else None)
         marker_ids.add(marker_id if _is_index(marker_id) else None)
-        poi_names.add(poi["name"] if isinstance(poi.get("name"), str) else None)
+        poi_names.add(poi_name if isinstance(poi_name, str) else None)
     return problems
 
 

@@ -139,32 +139,36 @@ class Nests(_Strict):
         0.0, ge=0.0, le=2.0, description="between neighbouring nests along the site x axis (m)"
     )
     clearance: Number = Field(ge=0.0005, le=0.02, description="per side between plate and nest brackets (m)")
-    approach_height: Number = Field(
-        0.10, ge=0.02, le=0.4, description="the approach pose is this far above the site, along site z (m)"
+    approach_height: Annotated[Number, Field(ge=0.02, le=0.4)] | None = Field(
+        None,
+        description="override: the approach pose is this far above the site, along site z (m); "
+        "default: chosen by the robot (0.10 m, lower where the arm cannot reach that high)",
     )
 
 
 class StationPoi(_Strict):
-    """Where the robot stands to work at the station (heading: the table's, facing table +x)."""
+    """Where the robot stands to work at the station (heading: the table's, facing table +x). Only the
+    name is the lab's; the distances are overrides of what the robot derives from the bench, the nests
+    and its own model (lab_description.station_placement)."""
 
-    name: Text = Field(description="unique POI name where the robot works at this station")
-    standoff: Number = Field(
-        ge=0.3,
-        le=1.0,
-        description="navigation stops base_footprint this far (m) in front of the middle of the nest "
-        "row (the POI); about 0.2 m more than work_standoff",
+    name: Text | None = Field(
+        None, description="unique POI name where the robot works (default: <station>_work)"
+    )
+    standoff: Annotated[Number, Field(ge=0.3, le=1.2)] | None = Field(
+        None,
+        description="override: navigation stops base_footprint this far (m) in front of the middle of "
+        "the nest row (the POI); default: work_standoff + 0.22",
     )
     work_standoff: Annotated[Number, Field(ge=0.3, le=1.0)] | None = Field(
         None,
-        description="the marker-guided final approach brings base_footprint this close (m) to work; "
-        "default: standoff; keep it 0.45 .. 0.55",
+        description="override: the marker-guided final approach brings base_footprint this close (m) to "
+        "work; default: the nearest that keeps the bench's front edge 0.37 m ahead (the standoff, if "
+        "only that is given)",
     )
-    lateral: Number = Field(
-        0.0,
-        ge=-0.5,
-        le=0.5,
-        description="and this far (m) to its left, so the nests lie on the right arm's side "
-        "(about 0.1 .. 0.15)",
+    lateral: Annotated[Number, Field(ge=-0.5, le=0.5)] | None = Field(
+        None,
+        description="override: and this far (m) to its left; default: the row's middle in the middle of "
+        "the right arm's 0.45 m band (0.225)",
     )
 
 
@@ -175,7 +179,7 @@ class Station(_Strict):
     table: Table
     marker: Marker
     nests: Nests
-    poi: StationPoi
+    poi: StationPoi = Field(default_factory=StationPoi, description="where the robot works (all optional)")
 
 
 class PlateStart(_Strict):

@@ -23,9 +23,9 @@ from typing import Any
 import numpy as np
 from labware_interfaces.msg import ErrorCodes
 
+from lab_description.station_placement import nest_working_pose
 from lab_description.world import Station
 from robot_port.execution import Execution
-from tiago_description import robot_model as rm
 from tiago_description import transforms as tf
 from tiago_description.kinematics import RobotKinematics, head_angles_towards
 from tiago_skills.behaviours import move_joints
@@ -37,9 +37,6 @@ HEAD_JOINTS = ("head_1_joint", "head_2_joint")
 # rad; the camera sees 63 deg across. The second look repeats the first once the torso stands.
 SEARCH_PAN_OFFSETS = (0.0, 0.0, 0.45, -0.45, 0.9, -0.9)
 ALIGN_SPEED = 0.3  # m/s cap for the short final drive (the acceleration limit keeps it lower anyway)
-# How far inside the working arm's band a nest must lie (the calibration and approach errors moved
-# nests up to 1.6 cm across its edge).
-ARM_SIDE_MARGIN_M = 0.03
 
 
 def planar(transform: np.ndarray) -> tuple[float, float, float]:
@@ -78,27 +75,16 @@ def _search(run: GoalRun, kinematics: RobotKinematics, target: np.ndarray, look:
 
 
 def working_pose(station: Station, sub_position: int, arm: str) -> np.ndarray:
-    """T_world_base where the robot works at nest ``sub_position``: the station's working pose, moved
-    sideways along the bench where the nest would lie less than ARM_SIDE_MARGIN_M inside the working
-    arm's band (0 to TOP_DOWN_REACH_BAND_M on its side of the base's centre line).
-
-    Why: a row may span the whole band, its end nests on the band's edges, and the calibration
-    errors then put one a centimetre beyond: the arm could not reach a nest 0.7 to 1.6 cm left of
-    the centre line, 0.78 to 0.84 m high (IK_FAILED), and at the far end, 0.45 m right, the fingers
-    closed on a plate pressed into its nest by 45 to 82 N and the grip let go of it (PLATE_SLIPPED)
-    (docs/explanation/decisions/working-pose-inside-the-arm-band.md)."""
-    T_world_work = station.aligned_pose().matrix()
-    side = -1.0 if arm == "right" else 1.0  # the working arm's side of the base, along its y
-    inward = side * float((tf.invert(T_world_work) @ station.T_world_site(sub_position))[1, 3])
-    wanted = min(max(inward, ARM_SIDE_MARGIN_M), rm.TOP_DOWN_REACH_BAND_M - ARM_SIDE_MARGIN_M)
-    if wanted == inward:
-        return T_world_work
-    log.info(
-        "nest %d of %s lies %.3f m to the %s arm's side: working from %.3f m further %s",
-        sub_position, station.name, inward, arm, abs(wanted - inward),
-        "left" if side * (wanted - inward) < 0 else "right",
-    )  # fmt: skip
-    return T_world_work @ tf.from_planar(0.0, side * (inward - wanted), 0.0)
+    """T_world_base where the robot works at nest ``sub_position`` (`station_placement.nest_working_pose`:
+    the station's working pose, moved along the bench to keep the nest inside the arm's band)."""
+    T_world_work = nest_working_pose(station, sub_position, arm)
+    moved = tf.invert(station.aligned_pose().matrix()) @ T_world_work
+    if abs(moved[1, 3]) > 1e-9:
+        log.info(
+            "nest %d of %s: working from %.3f m further %s, to keep it inside the %s arm's band",
+            sub_position, station.name, abs(moved[1, 3]), "left" if moved[1, 3] > 0 else "right", arm,
+        )  # fmt: skip
+    return T_world_work
 
 
 def align_base(

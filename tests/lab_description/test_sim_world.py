@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 import yaml
 
+from lab_description.station_placement import nest_working_poses
 from lab_description.world import DEFAULT_WORLD, WorldError, load_world
 from labware_model.holders import Nest
 from labware_model.labware import Plate
@@ -51,13 +52,13 @@ SHIPPED_WORLDS = sorted(DEFAULT_WORLD.parent.glob("*.yaml"))
 def test_work_poi_stands_in_front_of_the_nests_facing_them(world_file):
     world = load_world(world_file)
     for station in world.stations:
-        T_world_base = world.pois[station.poi].matrix()
-        for sub in range(1, station.sub_positions + 1):
+        T_world_poi = world.pois[station.poi].matrix()
+        for sub, T_world_base in nest_working_poses(station):
+            T_poi_site = tf.invert(T_world_poi) @ station.T_world_site(sub)
+            assert 0.55 <= T_poi_site[0, 3] <= 0.80  # the POI: behind the working pose (0.45 .. 0.55)
             T_base_site = tf.invert(T_world_base) @ station.T_world_site(sub)
-            assert 0.55 <= T_base_site[0, 3] <= 0.80  # the POI: behind the working pose (0.45 .. 0.55)
-            assert (
-                -0.45 - 1e-9 <= T_base_site[1, 3] <= 1e-9
-            )  # the right arm's band: 0 .. 0.45 m right of the base
+            # worked at from within the right arm's band: 0 .. 0.45 m right of the base
+            assert -0.45 - 1e-9 <= T_base_site[1, 3] <= 1e-9
             assert T_base_site[2, 3] == pytest.approx(station.table_size[2])
 
 

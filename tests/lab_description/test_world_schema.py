@@ -167,8 +167,8 @@ RULES: list[tuple[str, Mutation, str]] = [
     ),
     (
         "standoff",
-        lambda d: station(0, "poi")(d).update(standoff=1.2),
-        "stations[0].poi.standoff: 1.2 is outside 0.3 .. 1.0",
+        lambda d: station(0, "poi")(d).update(standoff=1.3),
+        "stations[0].poi.standoff: 1.3 is outside 0.3 .. 1.2",
     ),
     (
         "work standoff",
@@ -337,7 +337,8 @@ def test_optional_keys_take_their_documented_defaults(tmp_path: Path) -> None:
         0.0,
         0.1,
     )
-    assert (first.work_standoff, first.lateral) == (first.standoff, 0.0)
+    # only the standoff given: the final approach ends there; sideways, the row centred in the arm's band
+    assert (first.work_standoff, first.lateral) == (first.standoff, 0.225)
 
 
 def test_angles_are_degrees_in_the_file_and_radians_in_the_world() -> None:

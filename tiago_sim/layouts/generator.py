@@ -188,7 +188,7 @@ def _draw_layout(rng: random.Random, seed: int) -> dict[str, Any] | None:
 def _may_fit(placed: World | None, station: dict[str, Any], half: float) -> bool:
     """`_fits`'s own rules on the new station alone, before a new lab is built and checked: most
     candidates fail one of them (0.26 -> 0.1 s a layout)."""
-    new = station_from_raw(station)
+    new = station_from_raw(station, max(t["height"] for t in LABWARE_TYPES.values()))
     return True if new is None else _clear_alone(placed, new, half)  # None: the loader names it
 
 

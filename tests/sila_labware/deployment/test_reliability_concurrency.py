@@ -28,9 +28,7 @@ from tests.helpers.transfer_steps import Cell, finish
 
 PLATE = "plate_001"
 A1, B1 = ("station_a", 1), ("station_b", 1)
-GOAL_LINE = re.compile(
-    r"INFO tiago_skills\.action_servers: (/\w+) (\w+): sim ([\d.]+) \.\. ([\d.]+) s"
-)
+GOAL_LINE = re.compile(r"INFO tiago_skills\.action_servers: (/\w+) (\w+): sim ([\d.]+) \.\. ([\d.]+) s")
 
 
 @pytest.fixture(scope="module")

@@ -17,6 +17,7 @@ import numpy as np
 import pybullet as p
 import pytest
 
+from lab_description.station_placement import ARM_SIDE_MARGIN_M
 from lab_description.world import load_world
 from labware_model.holders import HotelSlot
 from labware_model.labware import Plate
@@ -25,7 +26,7 @@ from tiago_description.kinematics import RobotKinematics
 from tiago_description.robot_model import TOP_DOWN_REACH_BAND_M
 from tiago_description.transforms import compose_planar
 from tiago_sim.physics.simulation import Simulation
-from tiago_skills.base_alignment import ARM_SIDE_MARGIN_M, head_angles_towards, planar, working_pose
+from tiago_skills.base_alignment import head_angles_towards, planar, working_pose
 
 PLATE = "plate_001"
 
