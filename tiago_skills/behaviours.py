@@ -18,9 +18,11 @@ from typing import Any
 import numpy as np
 from labware_interfaces.msg import ErrorCodes
 
+from lab_description.serviceability import WORKING_CLEARANCE
 from robot_port.execution import Execution
 from robot_port.hardware import RobotHardware
 from robot_port.types import ARM_SIDES, JointTrajectory
+from tiago_description import robot_model as rm
 from tiago_description.kinematics import RobotKinematics
 from tiago_description.motion_library import HOTEL_MOTIONS, MotionLibrary
 from tiago_description.transforms import make_transform
@@ -35,6 +37,16 @@ TOOL_SPEED_INTO_POCKET = 0.08
 # 0.15 once "lost the plate" (SLOT_EMPTY): that was the hotel tray hitting the table, see base_alignment
 TOOL_SPEED_FREE = 0.35
 CREEP_HEIGHT = 0.018  # m above a pocket where the slow creep starts (rims: nest 6 mm, hotel 8 mm)
+
+# The tool stays this far ahead of the base (m) while it is in front of every bench: a bench's front
+# edge stands at least WORKING_CLEARANCE ahead of a working pose (the loader's rule), and an open
+# finger reaches OPEN_FINGER_REACH past the grasping frame along the closing axis, which points at
+# the bench at a nest. Moves between a bench and the hotel or a fixed posture pass this line level,
+# so on a standing bench (0.90 m) nothing dips onto its edge (seen: a finger 0.8 mm into the edge in
+# "Benchtop"; a straight line from a nest's approach to the hotel passed 2 mm over it).
+OPEN_FINGER_REACH = rm.FINGER_MOUNT_OFFSET + rm.FINGER_TRAVEL + rm.PAD_THICKNESS
+BENCH_EDGE_MARGIN = 0.02
+BENCH_FRONT_X = WORKING_CLEARANCE - OPEN_FINGER_REACH - BENCH_EDGE_MARGIN
 
 # Half-turn about the grasp x axis: the same top-down grasp with the fingers swapped.
 FLIP_ABOUT_APPROACH = make_transform(rotation=np.diag([1.0, -1.0, -1.0]))
@@ -161,7 +173,7 @@ class RobotBehaviours:
         # edge (0.36 .. 0.45 m ahead at a working pose, top up to 0.78 m) stands: Tuck after
         # GetLabware has grazed such an edge 1.5 mm deep. From the carry height the fold
         # stays above 0.85 m (tests/tiago_description/test_fold_sweep.py).
-        first = self.leave_hotel(run, arm)
+        first = self.leave_hotel(run, arm) or self.leave_bench(run, arm)
         speed = self.speed_scale() * self.motions.speed_scale
         for index, targets in enumerate(frames):
             span = (
@@ -316,6 +328,42 @@ class RobotBehaviours:
                 return 0.3
         return 0.0
 
+    def leave_bench(self, run: GoalRun, arm: str) -> float:
+        """If the tool is over a bench (ahead of BENCH_FRONT_X), go straight back to that line at its
+        height first; returns the progress used. The tool leaves a bench from a nest's approach pose,
+        which clears everything on it."""
+        joints = run.read(lambda hardware: dict(hardware.joint_positions()))
+        T_tool = self.tool_pose(arm, joints)
+        if T_tool[0, 3] <= BENCH_FRONT_X + BENCH_EDGE_MARGIN / 2:  # on the line ("Benchtop"), or behind it
+            return 0.0
+        T_front = T_tool.copy()
+        T_front[0, 3] = BENCH_FRONT_X
+        try:
+            self.straight_move(run, arm, T_front, TOOL_SPEED_FREE, (0.0, 0.3))
+        except ActionAbort as abort:
+            if abort.code != ErrorCodes.IK_FAILED:
+                raise
+            # Near the body the wrist may have to turn over along the line (a joint jump): the short
+            # joint-space move between the two level poses stays close to that level.
+            log.info("no straight way back from over the bench (%s): moving in joint space", abort.message)
+            self.joint_space_move(run, arm, T_front, (0.0, 0.3))
+        return 0.3
+
+    def rise_before_bench(self, run: GoalRun, arm: str, T_base_target: np.ndarray, first: float) -> float:
+        """Before the tool goes over a bench to a target higher than itself, rise straight up to the
+        target's height where it is (in front of the bench); returns the progress used so far."""
+        joints = run.read(lambda hardware: dict(hardware.joint_positions()))
+        T_tool = self.tool_pose(arm, joints)
+        if T_base_target[0, 3] <= BENCH_FRONT_X or T_tool[0, 3] > BENCH_FRONT_X + BENCH_EDGE_MARGIN:
+            return first
+        if T_tool[2, 3] >= T_base_target[2, 3] - 0.005:
+            return first
+        T_up = T_tool.copy()
+        T_up[2, 3] = T_base_target[2, 3]
+        middle = first + (1.0 - first) * 0.4
+        self.straight_move(run, arm, T_up, TOOL_SPEED_FREE, (first, middle))
+        return middle
+
     def _hotel_motion(self, run: GoalRun, arm: str, name: str, slot: int) -> None:
         T_approach = self.hotel_grasp_pose(slot, approach=True)
         if name == "Nest":  # straight down into the pocket (back up: NestApproach)
@@ -327,10 +375,11 @@ class RobotBehaviours:
         if self._over_slot(arm, joints, slot, 0.03):  # straight up or down to the approach pose
             self._tool_move(run, arm, T_approach, (0.0, 1.0))
             return
-        # From elsewhere: straight to the carry height above the slot, then straight down.
+        # From elsewhere: off the bench, straight to the carry height above the slot, then straight down.
+        first = self.leave_bench(run, arm)
         T_carry = T_approach.copy()
         T_carry[2, 3] += self.motions.hotel.carry_height_m
-        self._tool_move(run, arm, T_carry, (0.0, 0.7), free=True)
+        self._tool_move(run, arm, T_carry, (first, 0.7), free=True)
         self._tool_move(run, arm, T_approach, (0.7, 1.0))
 
     # -- gripper ------------------------------------------------------------------------

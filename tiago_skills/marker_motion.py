@@ -212,6 +212,7 @@ class MarkerMotionBehaviour:
             if in_nest:
                 self.behaviours.into_pocket(run, arm, T_base_target, (first, 1.0))
                 return {"marker_in_base": marker_in_base}
+            first = self.behaviours.rise_before_bench(run, arm, T_base_target, first)
             try:
                 self.behaviours.straight_move(run, arm, T_base_target, speed, (first, 1.0))
             except ActionAbort as abort:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from lab_description.station_placement import nest_working_poses
 from lab_description.world import DEFAULT_WORLD, load_world
 from tests.helpers.tool_moves import KINEMATICS
 from tiago_description import robot_model as rm
@@ -23,8 +24,9 @@ def kinematics() -> RobotKinematics:
 
 @pytest.mark.parametrize("world_file", SHIPPED_WORLDS, ids=[path.stem for path in SHIPPED_WORLDS])
 def test_ik_reaches_every_nest_from_its_working_pose_and_both_hotel_slots(kinematics, world_file):
-    """From where the marker-guided final approach parks the base (`work_standoff`), not from the
-    POI where navigation stops (farther back, out of the hotel's sweep); in every shipped world."""
+    """From where the marker-guided final approach parks the base for each nest (`work_standoff`,
+    moved along the bench for a nest outside the arm's band), not from the POI where navigation stops
+    (farther back, out of the hotel's sweep); in every shipped world."""
     world = load_world(world_file)
     seed = {
         "torso_lift_joint": 0.15,
@@ -32,8 +34,7 @@ def test_ik_reaches_every_nest_from_its_working_pose_and_both_hotel_slots(kinema
     }
     targets = []
     for station in world.stations:
-        T_world_base = station.aligned_pose().matrix()
-        for sub in range(1, station.sub_positions + 1):
+        for sub, T_world_base in nest_working_poses(station):
             T_base_site = tf.invert(T_world_base) @ station.T_world_site(sub)
             for lift in (0.0, station.approach_height):
                 position = T_base_site[:3, 3] + [0, 0, PLATE_HALF_HEIGHT + lift]

@@ -7,9 +7,9 @@ robot checks included (`lab_description.serviceability`). Same seed, same layout
 `random.Random`, no global state); the result is the world file's mapping, ready for YAML.
 
 Drawn per layout: 2 to 6 stations anywhere on the floor at any heading, the dock anywhere; per
-station the bench's depth, width and height, the marker's id, size and place on its stand, 1 to 4
-nests at a spacing, their place in front of the marker, the approach height and clearance, the
-working distance and the lateral offset that puts the row on the right arm's side. The plate to
+station a sitting or standing bench's depth, width and height, 1 to 6 nests at a spacing and their
+clearance, the marker's id and size on its stand beside the row (`station_draw.RANGES`). No robot
+field: the robot derives where it stops and works (`lab_description.station_placement`). The plate to
 move starts on any nest of the first station; other plates occupy other nests (the second station
 keeps a free one, the transfer's destination) and sometimes hotel slot 2. Labware types: a 96-well
 microplate and a 96-well deep-well plate, both SBS footprint.
@@ -36,6 +36,7 @@ from lab_description.serviceability import (
     bench_distance,
     bench_distances,
     drive_points,
+    working_poses,
 )
 from lab_description.world import Pose2D, Station, World, WorldError, station_from_raw, world_from_raw
 from lab_description.world_schema import MARKER_DICTIONARY_SIZE, MIRROR_AMBIGUOUS_MARKER_IDS
@@ -147,6 +148,14 @@ def layout_world(seed: int) -> World:
     return world_from_raw(generate_layout(seed), f"layout seed {seed}", f"layout_{seed}")
 
 
+def draw_floor_plan(rng: random.Random, seed: int) -> dict[str, Any]:
+    """The first floor plan drawn from `rng` that keeps the floor-plan rules (the loader's robot checks
+    not yet run): what a lab integrator might have, before `world check`."""
+    while (raw := _draw_layout(rng, seed)) is None:
+        pass
+    return raw
+
+
 def _draw_layout(rng: random.Random, seed: int) -> dict[str, Any] | None:
     count = rng.randint(*RANGES["stations"])
     floor = round(rng.uniform(*RANGES["floor_size"]) + 0.5 * count, 1)
@@ -210,20 +219,24 @@ def _clear_alone(placed: World | None, new: Station, half: float) -> bool:
     were placed. With `placed` None (no lab built yet) only what needs no dock."""
     if any(abs(c) > half for corner in _bench_corners(new) for c in corner):
         return False
-    poi, working = new.work_pose(), new.aligned_pose()
+    poi, workings = new.work_pose(), [pose for _label, pose in working_poses(new)]
     if placed is None:
-        return not _outside(poi, half) and bench_distance(new, working.x, working.y) >= WORKING_CLEARANCE
+        return not _outside(poi, half) and all(
+            bench_distance(new, working.x, working.y) >= WORKING_CLEARANCE for working in workings
+        )
     dock_poi = placed.pois[placed.dock_poi]
     if _outside(poi, half) or _outside(dock_poi, half):
         return False
     standing = [
         (placed.dock_pose, CORRIDOR),
-        *((s.aligned_pose(), WORKING_CLEARANCE) for s in placed.stations),
+        *((pose, WORKING_CLEARANCE) for s in placed.stations for _label, pose in working_poses(s)),
     ]
     if any(bench_distance(new, pose.x, pose.y) < clearance for pose, clearance in standing):
         return False
     if any(
-        bench_distance(bench, working.x, working.y) < WORKING_CLEARANCE for bench in (*placed.stations, new)
+        bench_distance(bench, working.x, working.y) < WORKING_CLEARANCE
+        for bench in (*placed.stations, new)
+        for working in workings
     ):
         return False
     points = [dock_poi, *(s.work_pose() for s in placed.stations)]

@@ -1,0 +1,82 @@
+"""How many labs drawn from lab furniture as it is sold does `world check` accept, and why not the rest.
+
+Why: a lab integrator describes their own lab; the robot must serve ordinary furniture, not labs
+drawn to suit it. Each seed draws a floor plan from `station_draw.RANGES` with no robot field in
+it (the floor-plan rules only: benches inside the floor, clear of each other and of the drives),
+and the loader then checks it with the robot model, as `world check` does. A refused lab lists
+each reason; `reason_kind` sorts them for the table.
+
+    python -m tiago_sim.layouts.acceptance FIRST COUNT
+"""
+
+from __future__ import annotations
+
+import argparse
+import random
+import re
+import sys
+from collections import Counter
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from lab_description.world import WorldError, world_from_raw
+from tiago_sim.layouts.generator import draw_floor_plan
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """One drawn lab: accepted, or the loader's reasons for refusing it (one line each)."""
+
+    seed: int
+    raw: dict
+    problems: tuple[str, ...]
+
+    @property
+    def accepted(self) -> bool:
+        return not self.problems
+
+
+def check_seed(seed: int) -> Verdict:
+    """The first floor plan drawn for `seed`, checked with the robot model."""
+    raw = draw_floor_plan(random.Random(seed), seed)
+    try:
+        world_from_raw(raw, f"furniture lab {seed}")
+    except WorldError as error:
+        return Verdict(seed, raw, error.problems)
+    return Verdict(seed, raw, ())
+
+
+def reason_kind(problem: str) -> str:
+    """A refusal's kind: reach, view, base (footprint or turning room) or other."""
+    if "reach" in problem:
+        return "a nest out of reach"
+    if "cannot see marker" in problem:
+        return "a marker out of view"
+    if re.search(r"m from bench|the undock drive", problem):
+        return "no room for the base"
+    return "other"
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(
+        prog="python -m tiago_sim.layouts.acceptance", description=__doc__.split("\n")[0]
+    )
+    parser.add_argument("first", type=int)
+    parser.add_argument("count", type=int)
+    args = parser.parse_args(argv)
+    kinds: Counter[str] = Counter()
+    accepted = 0
+    for seed in range(args.first, args.first + args.count):
+        verdict = check_seed(seed)
+        accepted += verdict.accepted
+        kinds.update({reason_kind(problem) for problem in verdict.problems})
+        if not verdict.accepted:
+            sys.stdout.write(f"{seed}: refused: {verdict.problems[0]}\n")
+    sys.stdout.write(f"accepted {accepted} of {args.count} labs ({100.0 * accepted / args.count:.1f} %)\n")
+    for kind, count in kinds.most_common():
+        sys.stdout.write(f"  refused for {kind}: {count}\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
