@@ -30,7 +30,6 @@ import logging
 import math
 from collections.abc import Iterator
 from dataclasses import dataclass
-from functools import lru_cache
 
 import numpy as np
 
@@ -38,8 +37,10 @@ from lab_description import station_placement as placement
 from tiago_description import robot_model
 from tiago_description import transforms as tf
 from tiago_description.hotel_model import hotel_sweep_radius
-from tiago_description.kinematics import CAMERA_FRAME, RobotKinematics, head_angles_towards
-from tiago_description.motion_library import HotelGrasp, load_motions
+from tiago_description.kinematics import CAMERA_FRAME, head_angles_towards
+from tiago_description.reach_map import highest_reached, interpolated_ceiling, reaches_nest
+from tiago_description.reach_map import reach_model as _robot
+from tiago_description.reach_map import reaches as _reachable
 
 log = logging.getLogger(__name__)
 
@@ -72,7 +73,10 @@ MARKER_MAX_OBLIQUITY_DEG = 60.0
 """Angle between the marker's normal and the line to the camera; ArUco corners blur beyond this."""
 MARKER_MIN_PIXELS = 40.0
 """Side of the black square in the 640 x 480 image; the pose error grows fast below this."""
-_FLIP_ABOUT_APPROACH = tf.make_transform(rotation=np.diag([1.0, -1.0, -1.0]))
+CEILING_MARGIN = 0.02
+"""A nest this far above `top_down_ceiling` at its (x, y) is out of reach without another IK try (the
+map's grid points are found to 5 mm and it is interpolated over 5 cm; neighbouring points differ by
+up to 1.5 cm)."""
 
 
 @dataclass(frozen=True)
@@ -87,39 +91,43 @@ class ServiceProblem:
         return "dock" if self.station_index < 0 else f"stations[{self.station_index}]"
 
 
-@lru_cache(maxsize=1)
-def _robot() -> tuple[RobotKinematics, HotelGrasp, dict[str, float]]:
-    motions = load_motions()
-    seed: dict[str, float] = {}
-    for frame in motions.frames_for("Benchtop", REACH_ARM):
-        seed.update(frame)
-    return RobotKinematics(), motions.hotel, seed
-
-
 def place_station(station, tallest_labware_m: float, *, reach: bool = True):  # noqa: ANN001, ANN201 - Station
     """The station with what its world file left to the robot chosen (`station_placement`): the
     working distance from the bench's front edge, the POI behind it, the row centred in the right
     arm's band, and (`reach`) the highest approach height from which the arm reaches every nest."""
     given = station.placement_from_file
     changes: dict[str, float] = {}
-    if "work_standoff" not in given:
-        changes["work_standoff"] = (
-            station.standoff
-            if "standoff" in given
-            else placement.least_working_distance(station, WORKING_CLEARANCE)
-        )
-    if "standoff" not in given:
-        changes["standoff"] = round(
-            changes.get("work_standoff", station.work_standoff) + placement.FINAL_APPROACH_M, 3
-        )
     if "lateral" not in given:
         changes["lateral"] = placement.centred_lateral(station)
     if "approach_height" not in given:
         changes["approach_height"] = placement.PREFERRED_APPROACH_HEIGHT_M
+    if "work_standoff" not in given:
+        if "standoff" in given:
+            changes["work_standoff"] = station.standoff
+        else:
+            changes["work_standoff"] = _nearest_seeing_distance(dataclasses.replace(station, **changes))
+    if "standoff" not in given:
+        work = changes.get("work_standoff", station.work_standoff)
+        changes["standoff"] = round(work + placement.FINAL_APPROACH_M, 3)
     placed = dataclasses.replace(station, **changes)
     if reach and "approach_height" not in given:
         placed = _highest_reachable_approach(placed, tallest_labware_m)
     return placed
+
+
+def _nearest_seeing_distance(station) -> float:  # noqa: ANN001
+    """The least working distance (`least_working_distance`) from which the head camera sees the marker
+    from every working pose, up to `placement.VIEW_BACKOFF_M` farther back (the nearest if none: the
+    view check then refuses the station). Nearer is better for the arm's reach; a marker beside the
+    row near the bench's front edge is seen too steeply, or too near, from the nearest pose."""
+    nearest = placement.least_working_distance(station, WORKING_CLEARANCE)
+    distance = nearest
+    while distance <= nearest + placement.VIEW_BACKOFF_M + 1e-9:
+        candidate = dataclasses.replace(station, work_standoff=round(distance, 3))
+        if not any(_view_problems(candidate, label, pose) for label, pose in working_poses(candidate)):
+            return round(distance, 3)
+        distance += placement.VIEW_BACKOFF_STEP_M
+    return nearest
 
 
 def _highest_reachable_approach(station, tallest_labware_m: float):  # noqa: ANN001, ANN202
@@ -129,7 +137,7 @@ def _highest_reachable_approach(station, tallest_labware_m: float):  # noqa: ANN
     heights = placement.approach_heights(tallest_labware_m)  # highest first
 
     def reached(index: int) -> bool:
-        return not _reach_problems(dataclasses.replace(station, approach_height=heights[index]))
+        return not _unreached(dataclasses.replace(station, approach_height=heights[index]))
 
     if reached(0):
         return dataclasses.replace(station, approach_height=heights[0])
@@ -228,6 +236,19 @@ def working_poses(station) -> list[tuple[str, object]]:  # noqa: ANN001
     return poses
 
 
+def station_alone_problems(station) -> list[str]:  # noqa: ANN001
+    """The station's own reasons the robot cannot serve it, whatever else stands in the lab: its nests
+    out of reach, its marker out of view, a working pose too near its own bench (a layout generator's
+    check of a drawn station before it places it)."""
+    problems = []
+    for label, working in working_poses(station):
+        problems += _clear(f"{station.name!r}: the base at {label}", working, WORKING_CLEARANCE, station)
+    problems += _reach_problems(station)
+    for label, pose in ((f"POI {station.poi}", station.work_pose()), *working_poses(station)):
+        problems += _view_problems(station, label, pose)
+    return problems
+
+
 def _station_problems(world, station) -> list[str]:  # noqa: ANN001
     poi = station.work_pose()
     problems: list[str] = []
@@ -243,28 +264,45 @@ def _station_problems(world, station) -> list[str]:  # noqa: ANN001
 
 
 def _reach_problems(station) -> list[str]:  # noqa: ANN001
-    kinematics, grasp, seed = _robot()
     problems = []
+    for sub_position, label, height, (x, y, z) in _unreached(station):
+        problems.append(
+            f"{station.name!r}: nest {sub_position} is out of the {REACH_ARM} arm's reach at "
+            f"any torso height ({label}, {height * 1000:.0f} mm above the nest: x {x:.3f} y {y:.3f} "
+            f"z {z:.3f} m in the working pose's base_footprint); {_reach_advice(station, x, y, z)}"
+        )
+    return problems
+
+
+def _unreached(station) -> list[tuple[int, str, float, tuple[float, float, float]]]:  # noqa: ANN001
+    """Each nest the arm does not reach top-down from its working pose: the sub-position, what is out of
+    reach (the grasp or the approach) and how high above the nest, and the nest in base_footprint.
+    A nest well above the highest one the arm reaches there (`top_down_ceiling`) is refused without
+    trying IK once more."""
+    kinematics, grasp, seed = _robot()
+    unreached = []
     for sub_position, T_world_base in placement.nest_working_poses(station):
         T_base_site = tf.levelled(tf.invert(T_world_base) @ station.T_world_site(sub_position))
-        heights = (("the grasp", 0.0), ("the approach", station.approach_height))
-        for label, height in heights:
+        x, y, z = (float(v) for v in T_base_site[:3, 3])
+        ceiling = top_down_ceiling(x, y, station.approach_height)  # None: the map cannot tell
+        if ceiling is not None and z > ceiling + CEILING_MARGIN:
+            unreached.append((sub_position, "the approach", station.approach_height, (x, y, z)))
+            continue
+        for label, height in (("the grasp", 0.0), ("the approach", station.approach_height)):
             T_base_grasp = T_base_site @ tf.make_transform((0.0, 0.0, height)) @ grasp.T_slot_grasp(False)
             if not _reachable(kinematics, T_base_grasp, seed):
-                x, y, z = T_base_site[:3, 3]
-                problems.append(
-                    f"{station.name!r}: nest {sub_position} is out of the {REACH_ARM} arm's reach at "
-                    f"any torso height ({label}, {height * 1000:.0f} mm above the nest: x {x:.3f} y {y:.3f} "
-                    f"z {z:.3f} m in the working pose's base_footprint); {_reach_advice(station, x, y, z)}"
-                )
+                unreached.append((sub_position, label, height, (x, y, z)))
                 break
-    return problems
+    return unreached
 
 
 def _reach_advice(station, x: float, y: float, z: float) -> str:  # noqa: ANN001
     """What would make a nest at (x, y, z) in the working pose's base_footprint reachable: the highest
     nest the arm reaches top-down this far ahead, and how near the front edge the base may stand."""
-    ceiling = top_down_ceiling(round(x, 2), round(y, 2), station.approach_height)
+    ceiling = top_down_ceiling(x, y, station.approach_height)
+    if ceiling is None:  # at the edge of the map: ask the model itself
+        grasp_ceiling = highest_reached(lambda height: reaches_nest(x, y, height))
+        ceiling = None if grasp_ceiling is None else grasp_ceiling - station.approach_height
     nearest = placement.least_working_distance(station, WORKING_CLEARANCE)
     reach = (
         f"from here the arm reaches a nest up to {math.floor(ceiling * 100) / 100:.2f} m above the floor"
@@ -277,33 +315,20 @@ def _reach_advice(station, x: float, y: float, z: float) -> str:  # noqa: ANN001
     )
 
 
-@lru_cache(maxsize=256)
 def top_down_ceiling(x: float, y: float, approach_height: float) -> float | None:
     """The highest nest (its floor above the floor, m) that the arm reaches top-down, grasp and approach,
-    at (x, y) in base_footprint; None if none from 0.3 m up. Bisection to 5 mm on the robot model."""
-    kinematics, grasp, seed = _robot()
-
-    def reached(z: float) -> bool:
-        site = tf.make_transform((x, y, z))
-        return all(
-            _reachable(kinematics, site @ tf.make_transform((0.0, 0.0, h)) @ grasp.T_slot_grasp(False), seed)
-            for h in (0.0, approach_height)
-        )
-
-    low, high = 0.3, 1.3
-    if not reached(low):
+    at (x, y) in base_footprint; None if none from 0.3 m up. The approach `approach_height` above a
+    nest is the grasp of a nest that much higher, so this is `top_down_grasp_ceiling` less it."""
+    ceiling = top_down_grasp_ceiling(x, y)
+    if ceiling is None:
         return None
-    while high - low > 0.005:
-        middle = (low + high) / 2
-        low, high = (middle, high) if reached(middle) else (low, middle)
-    return low
+    return ceiling - approach_height
 
 
-def _reachable(kinematics: RobotKinematics, T_base_grasp: np.ndarray, seed: dict[str, float]) -> bool:
-    for twin in (T_base_grasp, T_base_grasp @ _FLIP_ABOUT_APPROACH):
-        if kinematics.inverse(REACH_ARM, twin, seed, use_torso=True, restarts=20).success:
-            return True
-    return False
+def top_down_grasp_ceiling(x: float, y: float) -> float | None:
+    """The highest nest floor (m above the floor) whose top-down grasp the arm reaches at (x, y) in
+    base_footprint at any torso height (`tiago_description.reach_map`, interpolated); None if none."""
+    return interpolated_ceiling(x, y)
 
 
 def _view_problems(station, label: str, pose) -> list[str]:  # noqa: ANN001

@@ -10,8 +10,10 @@ state are the constants here.
 
 The choice, per station (the base faces the bench, as its heading says):
 - working distance: the least that keeps the bench's front edge `WORKING_CLEARANCE` ahead of the
-  base (the hotel tray's turning circle and where the final approach may end): the arm reaches
-  higher the nearer the base stands (top-down, at 0.45 m from the nest: 0.90 m; at 0.65 m: 0.78 m);
+  base (the hotel tray's turning circle and where the final approach may end) and from which the head
+  camera sees the marker: the arm reaches higher the nearer the base stands (top-down, at 0.45 m
+  from the nest: 0.90 m; at 0.65 m: 0.78 m), and a marker beside the row near the front edge is seen
+  too steeply from too near;
 - the POI: `FINAL_APPROACH_M` farther back, where navigation stops and the marker is first seen;
 - sideways: the row's middle in the middle of the working arm's band, so both ends keep the most
   room for the calibration errors; a nest beyond `ARM_SIDE_MARGIN_M` inside the band is worked at
@@ -46,6 +48,10 @@ APPROACH_CLEARANCE_M = 0.02
 """The least approach height is the tallest labware type plus this: the held plate passes over a plate
 in the next nest."""
 APPROACH_HEIGHT_STEP_M = 0.01
+VIEW_BACKOFF_M = 0.25
+"""The working pose may lie this much farther back than the nearest (m) for the head camera to see the
+marker from it."""
+VIEW_BACKOFF_STEP_M = 0.01
 ARM_SIDE_MARGIN_M = 0.03
 """How far inside the working arm's band a nest must lie (the calibration and approach errors moved
 nests up to 1.6 cm across its edge)."""

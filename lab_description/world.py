@@ -279,17 +279,18 @@ def _radians(values: tuple[float, float, float]) -> tuple[float, float, float]:
     return (roll, pitch, yaw)
 
 
-def station_from_raw(raw: Any, tallest_labware_m: float) -> Station | None:
+def station_from_raw(raw: Any, tallest_labware_m: float, *, reach: bool = False) -> Station | None:
     """One station's mapping as the program reads it, placed for labware up to `tallest_labware_m`
-    high (its approach height left unchecked against the arm's reach), or None if it breaks the
-    schema; none of the checks that need the rest of the lab (a layout generator's quick look)."""
+    high (with `reach`, its approach height chosen against the arm's reach, else the preferred), or
+    None if it breaks the schema; none of the checks that need the rest of the lab (a layout
+    generator's look at a candidate)."""
     try:
         item = schema.Station.model_validate(raw)
     except ValueError:  # pydantic's ValidationError
         return None
     from lab_description.serviceability import place_station
 
-    return place_station(_station(item), tallest_labware_m, reach=False)
+    return place_station(_station(item), tallest_labware_m, reach=reach)
 
 
 def _station(item: schema.Station) -> Station:

@@ -36,6 +36,11 @@ def _paths_line(paths: PoiPaths) -> str:
     return line + (f"; {missing} without a path" if missing else "; every POI reachable from every other")
 
 
+def _placed(field: str, station, value: str) -> str:  # noqa: ANN001 - a Station
+    """A placement number, marked `*` where the robot chose it (the file left it out)."""
+    return value if field in station.placement_from_file else f"{value}*"
+
+
 def summary(world: World, paths: PoiPaths) -> str:
     """A short table: the stations with marker, nests, POI and plates; the other POIs; labware types;
     obstacles; the planned paths."""
@@ -46,10 +51,20 @@ def summary(world: World, paths: PoiPaths) -> str:
             plates_at.setdefault(holder.station, []).append(f"{plate.labware_id}@{holder.sub_position}")
         elif isinstance(holder, HotelSlot):
             aboard.append(f"{plate.labware_id}@{holder.index}")
-    rows = [("station", "marker", "nests", "POI", "plates")]
+    rows = [("station", "marker", "nests", "POI", "works at", "approach", "plates")]
     for station in world.stations:
         plates = " ".join(plates_at.get(station.name, [])) or "-"
-        rows.append((station.name, str(station.marker_id), str(station.sub_positions), station.poi, plates))
+        rows.append(
+            (
+                station.name,
+                str(station.marker_id),
+                str(station.sub_positions),
+                station.poi,
+                _placed("work_standoff", station, f"{station.work_standoff:.2f} m"),
+                _placed("approach_height", station, f"{station.approach_height:.2f} m"),
+                plates,
+            )
+        )
     widths = [max(len(row[column]) for row in rows) for column in range(len(rows[0]))]
     lines = [f"{world.name}: {world.source} (floor {world.floor_size:g} m)"]
     lines += [
@@ -58,6 +73,11 @@ def summary(world: World, paths: PoiPaths) -> str:
     ]
     station_pois = {station.poi for station in world.stations}
     others = [name for name in world.pois if name not in station_pois]
+    if any(
+        station.placement_from_file != {"standoff", "work_standoff", "lateral", "approach_height"}
+        for station in world.stations
+    ):
+        lines.append("  *: chosen by the robot from the lab's geometry (the file leaves it out)")
     lines.append(f"POIs: {', '.join(others)} (in front of the dock: {world.dock_poi}), and one per station")
     lines.append(f"hotel: {world.hotel_slots} slots; {' '.join(aboard) or 'empty'}")
     for name, labware in world.labware_types.items():

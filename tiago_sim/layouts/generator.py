@@ -36,6 +36,7 @@ from lab_description.serviceability import (
     bench_distance,
     bench_distances,
     drive_points,
+    station_alone_problems,
     working_poses,
 )
 from lab_description.world import Pose2D, Station, World, WorldError, station_from_raw, world_from_raw
@@ -54,6 +55,7 @@ CORRIDOR = HOTEL_SWEEP_RADIUS + TURN_MARGIN
 # two sigma off (and 1.5 sigma turned) too.
 STOP_ERROR_M = 0.06
 STOP_ERROR_RAD = math.radians(3.0)
+TALLEST_LABWARE_M = max(sizes["height"] for sizes in LABWARE_TYPES.values())
 PLACEMENT_TRIES = 300  # per station, before the whole floor is drawn again
 LAYOUT_TRIES = 50
 
@@ -151,12 +153,14 @@ def layout_world(seed: int) -> World:
 def draw_floor_plan(rng: random.Random, seed: int) -> dict[str, Any]:
     """The first floor plan drawn from `rng` that keeps the floor-plan rules (the loader's robot checks
     not yet run): what a lab integrator might have, before `world check`."""
-    while (raw := _draw_layout(rng, seed)) is None:
+    while (raw := _draw_layout(rng, seed, servable=False)) is None:
         pass
     return raw
 
 
-def _draw_layout(rng: random.Random, seed: int) -> dict[str, Any] | None:
+def _draw_layout(rng: random.Random, seed: int, *, servable: bool = True) -> dict[str, Any] | None:
+    """A floor plan, or None if a station found no place; `servable`: only stations the robot serves
+    on their own (`_servable_station`), else any station the furniture ranges give."""
     count = rng.randint(*RANGES["stations"])
     floor = round(rng.uniform(*RANGES["floor_size"]) + 0.5 * count, 1)
     half = floor / 2 - WALL_MARGIN
@@ -180,7 +184,7 @@ def _draw_layout(rng: random.Random, seed: int) -> dict[str, Any] | None:
     }
     placed: World | None = None  # the lab of the stations placed so far
     for name, marker_id in zip(names, marker_ids, strict=True):
-        station = draw_station(rng, name, marker_id)
+        station = _servable_station(rng, name, marker_id) if servable else draw_station(rng, name, marker_id)
         for _ in range(PLACEMENT_TRIES):
             pose = [round(rng.uniform(-half, half), 2), round(rng.uniform(-half, half), 2)]
             station["table"]["pose"] = [*pose, float(rng.randrange(-180, 180))]
@@ -194,10 +198,20 @@ def _draw_layout(rng: random.Random, seed: int) -> dict[str, Any] | None:
     return raw
 
 
+def _servable_station(rng: random.Random, name: str, marker_id: int) -> dict[str, Any]:
+    """A drawn station the robot can serve on its own (`station_alone_problems`); the furniture ranges
+    include benches above the arm's reach, which are drawn again."""
+    while True:
+        station = draw_station(rng, name, marker_id)
+        placed = station_from_raw(station, TALLEST_LABWARE_M, reach=True)
+        if placed is not None and not station_alone_problems(placed):
+            return station
+
+
 def _may_fit(placed: World | None, station: dict[str, Any], half: float) -> bool:
     """`_fits`'s own rules on the new station alone, before a new lab is built and checked: most
     candidates fail one of them (0.26 -> 0.1 s a layout)."""
-    new = station_from_raw(station, max(t["height"] for t in LABWARE_TYPES.values()))
+    new = station_from_raw(station, TALLEST_LABWARE_M)
     return True if new is None else _clear_alone(placed, new, half)  # None: the loader names it
 
 

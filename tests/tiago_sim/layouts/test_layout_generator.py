@@ -39,7 +39,11 @@ def test_every_generated_layout_loads_and_stays_in_its_ranges(tmp_path: Path, se
     assert low <= len(world.stations) <= high
     for station in world.stations:
         assert RANGES["nests"][0] <= station.sub_positions <= RANGES["nests"][1]
-        assert RANGES["bench_height"][0] <= station.table_size[2] <= RANGES["bench_height"][1]
+        assert any(
+            low <= station.table_size[2] <= high
+            for low, high in (RANGES["sitting_bench_height"], RANGES["standing_bench_height"])
+        )
+        assert station.placement_from_file == frozenset()  # nothing about the robot in the file
         assert RANGES["marker_size"][0] <= station.marker_size <= RANGES["marker_size"][1]
         for sub_position in range(1, station.sub_positions + 1):  # every nest floor on the bench top
             assert abs(station.T_world_site(sub_position)[2, 3] - station.table_size[2]) < 1e-9
@@ -61,7 +65,8 @@ def test_forty_layouts_cover_headings_nest_counts_and_both_plate_types() -> None
     stations = [station for layout in layouts for station in layout["stations"]]
     headings = {int(station["table"]["pose"][2] // 90) for station in stations}  # the four quadrants
     assert headings == {-2, -1, 0, 1}
-    assert {station["nests"]["sub_positions"] for station in stations} == {1, 2, 3, 4}
+    assert {station["nests"]["sub_positions"] for station in stations} == set(range(1, 7))
+    assert max(station["table"]["size"][2] for station in stations) > RANGES["standing_bench_height"][0]
     assert {len(layout["stations"]) for layout in layouts} == set(range(2, 7))
     moved_types = {layout["plates"][0]["type"] for layout in layouts}
     assert moved_types == set(LABWARE_TYPES)
