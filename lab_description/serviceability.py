@@ -236,14 +236,14 @@ def working_poses(station) -> list[tuple[str, object]]:  # noqa: ANN001
     return poses
 
 
-def station_alone_problems(station) -> list[str]:  # noqa: ANN001
+def station_alone_problems(station, *, advise: bool = True) -> list[str]:  # noqa: ANN001
     """The station's own reasons the robot cannot serve it, whatever else stands in the lab: its nests
     out of reach, its marker out of view, a working pose too near its own bench (a layout generator's
-    check of a drawn station before it places it)."""
+    check of a drawn station before it places it; `advise` as `_reach_problems`)."""
     problems = []
     for label, working in working_poses(station):
         problems += _clear(f"{station.name!r}: the base at {label}", working, WORKING_CLEARANCE, station)
-    problems += _reach_problems(station)
+    problems += _reach_problems(station, advise=advise)
     for label, pose in ((f"POI {station.poi}", station.work_pose()), *working_poses(station)):
         problems += _view_problems(station, label, pose)
     return problems
@@ -263,13 +263,16 @@ def _station_problems(world, station) -> list[str]:  # noqa: ANN001
     return problems
 
 
-def _reach_problems(station) -> list[str]:  # noqa: ANN001
+def _reach_problems(station, *, advise: bool = True) -> list[str]:  # noqa: ANN001
+    """Each nest out of reach, with (`advise`) how high the arm reaches there: that costs IK at the
+    edge of the reach map, which a generator that only wants to know whether does without."""
     problems = []
     for sub_position, label, height, (x, y, z) in _unreached(station):
+        advice = f"; {_reach_advice(station, x, y, z)}" if advise else ""
         problems.append(
             f"{station.name!r}: nest {sub_position} is out of the {REACH_ARM} arm's reach at "
             f"any torso height ({label}, {height * 1000:.0f} mm above the nest: x {x:.3f} y {y:.3f} "
-            f"z {z:.3f} m in the working pose's base_footprint); {_reach_advice(station, x, y, z)}"
+            f"z {z:.3f} m in the working pose's base_footprint){advice}"
         )
     return problems
 
