@@ -118,8 +118,9 @@ def place_station(station, tallest_labware_m: float, *, reach: bool = True):  # 
 def _nearest_seeing_distance(station) -> float:  # noqa: ANN001
     """The least working distance (`least_working_distance`) from which the head camera sees the marker
     from every working pose, up to `placement.VIEW_BACKOFF_M` farther back (the nearest if none: the
-    view check then refuses the station). Nearer is better for the arm's reach; a marker beside the
-    row near the bench's front edge is seen too steeply, or too near, from the nearest pose."""
+    view check then refuses the station). Nearer is better for the arm's reach, which only shrinks
+    farther back; a marker beside the row near the bench's front edge is seen too steeply, or too
+    near, from the nearest pose."""
     nearest = placement.least_working_distance(station, WORKING_CLEARANCE)
     distance = nearest
     while distance <= nearest + placement.VIEW_BACKOFF_M + 1e-9:

@@ -43,8 +43,12 @@ def test_ik_reaches_every_nest_from_its_working_pose_and_both_hotel_slots(kinema
         T_base_slot = kinematics.forward({}, f"hotel_slot_{slot}")
         for lift in (0.0, 0.15):
             targets.append(top_down_grasp(T_base_slot[:3, 3] + [0, 0, PLATE_HALF_HEIGHT + lift], 0.0))
-    for index, target in enumerate(targets):
-        result = kinematics.inverse("right", target, seed, use_torso=True, seed=index)
+    flip = tf.make_transform(rotation=np.diag([1.0, -1.0, -1.0]))  # the same grasp, fingers swapped
+    for index, wanted in enumerate(targets):
+        for target in (wanted, wanted @ flip):  # as the skills and the loader: either finger order
+            result = kinematics.inverse("right", target, seed, use_torso=True, seed=index)
+            if result.success:
+                break
         assert result.success, f"target {index} unreachable: {result}"
         q = dict(seed, **result.joint_positions)
         reached = kinematics.forward(q, "gripper_right_grasping_frame")

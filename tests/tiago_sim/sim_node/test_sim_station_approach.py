@@ -124,7 +124,7 @@ def test_a_nest_on_an_edge_of_the_arms_band_is_worked_at_from_a_pose_moved_to_ke
     (the edge of the right arm's band); with the calibration errors it came to lie a centimetre left
     of it and the arm could not reach it (IK_FAILED); 102011 and 102031: at the band's far edge the
     plate was pressed into its nest at the grasp and the grip let go of it. The working pose for such
-    a nest moves sideways until the nest lies ARM_SIDE_MARGIN_M inside the band; the others keep the
+    a nest moves sideways until the nest lies in the middle of the band; the others keep the
     station's."""
     station = load_world().station("station_a")
     nominal = station.aligned_pose().matrix()
@@ -133,9 +133,9 @@ def test_a_nest_on_an_edge_of_the_arms_band_is_worked_at_from_a_pose_moved_to_ke
     on_line = dataclasses.replace(station, lateral=station.lateral - _inward(nominal, station, 1))
     assert _inward(on_line.aligned_pose().matrix(), on_line, 1) == pytest.approx(0.0, abs=1e-9)
     moved = working_pose(on_line, 1, "right")
-    assert _inward(moved, on_line, 1) == pytest.approx(ARM_SIDE_MARGIN_M, abs=1e-9)
+    assert _inward(moved, on_line, 1) == pytest.approx(TOP_DOWN_REACH_BAND_M / 2, abs=1e-9)  # the middle
     np.testing.assert_allclose(moved[:3, :3], on_line.aligned_pose().matrix()[:3, :3])  # sideways only
     np.testing.assert_allclose(working_pose(on_line, 2, "right"), on_line.aligned_pose().matrix())
     far_end = dataclasses.replace(station, lateral=on_line.lateral + TOP_DOWN_REACH_BAND_M)  # 0.45 m right
     moved = working_pose(far_end, 1, "right")
-    assert _inward(moved, far_end, 1) == pytest.approx(TOP_DOWN_REACH_BAND_M - ARM_SIDE_MARGIN_M, abs=1e-9)
+    assert _inward(moved, far_end, 1) == pytest.approx(TOP_DOWN_REACH_BAND_M / 2, abs=1e-9)
