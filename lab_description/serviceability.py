@@ -30,6 +30,7 @@ import logging
 import math
 from collections.abc import Iterator
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -283,21 +284,33 @@ def _unreached(station) -> list[tuple[int, str, float, tuple[float, float, float
     reach (the grasp or the approach) and how high above the nest, and the nest in base_footprint.
     A nest well above the highest one the arm reaches there (`top_down_ceiling`) is refused without
     trying IK once more."""
-    kinematics, grasp, seed = _robot()
     unreached = []
     for sub_position, T_world_base in placement.nest_working_poses(station):
         T_base_site = tf.levelled(tf.invert(T_world_base) @ station.T_world_site(sub_position))
         x, y, z = (float(v) for v in T_base_site[:3, 3])
-        ceiling = top_down_ceiling(x, y, station.approach_height)  # None: the map cannot tell
-        if ceiling is not None and z > ceiling + CEILING_MARGIN:
-            unreached.append((sub_position, "the approach", station.approach_height, (x, y, z)))
-            continue
-        for label, height in (("the grasp", 0.0), ("the approach", station.approach_height)):
-            T_base_grasp = T_base_site @ tf.make_transform((0.0, 0.0, height)) @ grasp.T_slot_grasp(False)
-            if not _reachable(kinematics, T_base_grasp, seed):
-                unreached.append((sub_position, label, height, (x, y, z)))
-                break
+        key = (round(x, 4), round(y, 4), round(z, 4), round(tf.yaw_of(T_base_site), 4))
+        label = _nest_unreached(*key, round(station.approach_height, 4))
+        if label is not None:
+            height = 0.0 if label == "the grasp" else station.approach_height
+            unreached.append((sub_position, label, height, (x, y, z)))
     return unreached
+
+
+@lru_cache(maxsize=16384)
+def _nest_unreached(x: float, y: float, z: float, yaw: float, approach_height: float) -> str | None:
+    """What of a nest at (x, y, z, yaw) in base_footprint the arm does not reach top-down: "the grasp",
+    "the approach" (`approach_height` above it), or None. Cached: the loader and a layout generator ask
+    about the same nest relative to its working pose again and again."""
+    ceiling = top_down_ceiling(x, y, approach_height)  # None: the map cannot tell
+    if ceiling is not None and z > ceiling + CEILING_MARGIN:
+        return "the approach"
+    kinematics, grasp, seed = _robot()
+    T_base_site = tf.from_planar(x, y, yaw, z)
+    for label, height in (("the grasp", 0.0), ("the approach", approach_height)):
+        T_base_grasp = T_base_site @ tf.make_transform((0.0, 0.0, height)) @ grasp.T_slot_grasp(False)
+        if not _reachable(kinematics, T_base_grasp, seed):
+            return label
+    return None
 
 
 def _reach_advice(station, x: float, y: float, z: float) -> str:  # noqa: ANN001

@@ -29,7 +29,7 @@ from tiago_sim.layouts.station_draw import LABWARE_TYPES, RANGES
 REPOSITORY = Path(__file__).resolve().parents[3]
 
 
-@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(seed=st.integers(min_value=0, max_value=2**31 - 1))
 def test_every_generated_layout_loads_and_stays_in_its_ranges(tmp_path: Path, seed: int) -> None:
     path = tmp_path / f"layout_{seed}.yaml"
@@ -60,8 +60,8 @@ def test_the_same_seed_gives_the_same_layout_and_another_seed_another() -> None:
     assert layout_yaml(7) != layout_yaml(8)
 
 
-def test_forty_layouts_cover_headings_nest_counts_and_both_plate_types() -> None:
-    layouts = [generate_layout(seed) for seed in range(40)]
+def test_twenty_layouts_cover_headings_nest_counts_and_both_plate_types() -> None:
+    layouts = [generate_layout(seed) for seed in range(20)]
     stations = [station for layout in layouts for station in layout["stations"]]
     headings = {int(station["table"]["pose"][2] // 90) for station in stations}  # the four quadrants
     assert headings == {-2, -1, 0, 1}
