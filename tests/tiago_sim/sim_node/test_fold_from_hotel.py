@@ -47,6 +47,14 @@ class RecordingHardware:
         )  # fmt: skip
 
 
+def benchtop_joints() -> dict[str, float]:
+    """The arm, torso and head where the "Benchtop" motion leaves them."""
+    joints: dict[str, float] = {}
+    for frame in load_motions().frames_for("Benchtop", ARM):
+        joints.update(frame)
+    return joints
+
+
 def goal_run(hardware: RecordingHardware) -> GoalRun:
     handle = SimpleNamespace(is_cancel_requested=False, publish_feedback=lambda _message: None)
     return GoalRun(handle, PlayMotion.Feedback, hardware)
@@ -66,9 +74,7 @@ def behaviours() -> RobotBehaviours:
 def joints_over_hotel_slot(slot: int) -> dict[str, float]:
     """The arm at the approach of a hotel slot (where GetLabware's retract leaves it), gripper open."""
     kinematics, motions = RobotKinematics(), load_motions()
-    seed: dict[str, float] = {}
-    for frame in motions.frames_for("Benchtop", ARM):
-        seed.update(frame)
+    seed = benchtop_joints()
     seed.update({"torso_lift_joint": 0.25, **{n: rm.FINGER_TRAVEL for n in rm.finger_joint_names(ARM)}})
     T = kinematics.forward({}, f"hotel_slot_{slot}") @ motions.hotel.T_slot_grasp(approach=True)
     result = kinematics.inverse(ARM, T, seed, use_torso=False, restarts=40)
@@ -92,9 +98,7 @@ def test_tuck_over_the_hotel_rises_to_the_carry_height_first(slot: int) -> None:
 
 def test_tuck_elsewhere_folds_straight_away() -> None:
     robot = behaviours()
-    bench: dict[str, float] = {}
-    for frame in robot.motions.frames_for("Benchtop", ARM):
-        bench.update(frame)
+    bench = benchtop_joints()
     hardware = RecordingHardware(bench)
     robot.play_motion(goal_run(hardware), SimpleNamespace(arm=ARM, motion_name="Tuck", hotel_slot=0))
     assert [kind for kind, _ in hardware.started] == ["move_joints"]
@@ -103,9 +107,7 @@ def test_tuck_elsewhere_folds_straight_away() -> None:
 def joints_over_a_nest(x: float, y: float, z: float) -> dict[str, float]:
     """The arm top-down over a nest ahead of the base (a nest's approach pose), gripper open."""
     kinematics, motions = RobotKinematics(), load_motions()
-    seed: dict[str, float] = {}
-    for frame in motions.frames_for("Benchtop", ARM):
-        seed.update(frame)
+    seed = benchtop_joints()
     seed.update({n: rm.FINGER_TRAVEL for n in rm.finger_joint_names(ARM)})
     T = make_transform((x, y, z)) @ motions.hotel.T_slot_grasp(approach=False)
     result = kinematics.inverse(ARM, T, seed, use_torso=True, restarts=40)
@@ -131,9 +133,7 @@ def test_leaving_a_bench_goes_straight_back_to_its_front_line_first(motion: str)
 
 def test_towards_a_nest_higher_than_the_tool_the_tool_rises_in_front_of_the_bench_first() -> None:
     robot = behaviours()
-    bench: dict[str, float] = {}
-    for frame in robot.motions.frames_for("Benchtop", ARM):
-        bench.update(frame)
+    bench = benchtop_joints()
     hardware = RecordingHardware(bench)
     start = robot.tool_pose(ARM, bench)
     target = make_transform((0.49, -0.20, 0.95)) @ robot.motions.hotel.T_slot_grasp(approach=False)
