@@ -103,7 +103,17 @@ def test_world_check_prints_the_table_and_draws_the_lab(tmp_path: Path) -> None:
     assert (done.returncode, done.stderr) == (0, "")
     lines = done.stdout.splitlines()
     assert lines[0] == f"default lab: {DEFAULT_WORLD} (floor 12 m)"
-    assert lines[2].split() == ["station_a", "3", "2", "station_a_work", "plate_001@1"]
+    assert lines[2].split() == [
+        "station_a",
+        "3",
+        "2",
+        "station_a_work",
+        "0.50",
+        "m",
+        "0.10",
+        "m",
+        "plate_001@1",
+    ]
     assert lines[-1] == f"picture: {picture}" and picture.stat().st_size > 0
 
 

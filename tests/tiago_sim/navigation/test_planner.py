@@ -8,9 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from lab_description.world import DEFAULT_WORLD, load_world, world_from_raw
+from lab_description.world import DEFAULT_WORLD, load_world
 from lab_description.world_obstacles import KEEP_CLEAR_M
-from tiago_sim.layouts.generator import generate_layout
 from tiago_sim.measuring.disturbances import DisturbanceLevels
 from tiago_sim.navigation.occupancy_map import Footprint, OccupancyMap, build_map
 from tiago_sim.navigation.plan_benchmark import measure
@@ -25,6 +24,7 @@ from tiago_sim.navigation.planner import (
 )
 
 BENCH_IN_THE_WAY = DEFAULT_WORLD.parent / "bench_in_the_way.yaml"
+UNUSUAL_BENCHES = DEFAULT_WORLD.parent / "unusual_benches.yaml"
 
 
 def room(*footprints: Footprint, side: float = 6.0) -> OccupancyMap:
@@ -148,8 +148,8 @@ def test_a_straight_entry_past_a_tall_obstacle_within_the_arms_reach_is_refused(
 
 
 def test_the_arms_map_keeps_a_low_bench_but_not_its_tall_marker_board() -> None:
-    world = world_from_raw(generate_layout(12), "layout 12")
-    (station,) = [s for s in world.stations if s.name == "labeler"]  # a 0.64 m bench
+    world = load_world(UNUSUAL_BENCHES)
+    (station,) = [s for s in world.stations if s.name == "low_bench"]  # a 0.60 m bench
     above = ARMS_CLEAR_ABOVE_M
     assert station.table_size[2] < above < station.top_height()  # a low bench with a tall board
     arms_map = build_map(world, above_m=above)
