@@ -20,6 +20,7 @@ from __future__ import annotations
 import logging
 import multiprocessing
 import os
+import pickle
 import signal
 import sys
 import tempfile
@@ -68,9 +69,20 @@ def _run_in_worker(options: CampaignOptions, trial_seed: int, record: bool) -> T
 
 
 def _noted(trial: Callable[..., TrialOutcome], options: CampaignOptions, seed: int, record: bool) -> Any:
-    """Note on disk that this trial started (it outlives a worker that dies), then run it."""
+    """Note on disk that this trial started, run it, and keep its outcome on disk too: both outlive
+    a worker that dies, and a pool broken by another worker loses the results it had not yet passed
+    on (a trial that ended then is not lost)."""
     (Path(_started_dir) / str(seed)).touch()
-    return trial(options, seed, record)
+    outcome = trial(options, seed, record)
+    (Path(_started_dir) / f"{seed}.outcome").write_bytes(pickle.dumps(outcome))
+    return outcome
+
+
+def _noted_trials(started_dir: Path) -> tuple[set[int], dict[int, TrialOutcome]]:
+    """The seeds whose trials began, and the outcomes of those that ended, as the workers noted them."""
+    begun = {int(path.name) for path in started_dir.iterdir() if path.name.isdigit()}
+    ended = {int(path.stem): pickle.loads(path.read_bytes()) for path in started_dir.glob("*.outcome")}
+    return begun, ended
 
 
 def lost_trial(trial_seed: int, why: str) -> TrialOutcome:
@@ -131,8 +143,9 @@ def _run_pool(
             try:
                 outcome = future.result()  # a worker's KeyboardInterrupt arrives here as one too
             except BrokenProcessPool as broken:
-                begun = {int(path.name) for path in Path(started.name).iterdir()}
-                return _after_a_lost_worker(futures, begun, broken, outcomes, progress, on_trial, flags)
+                pool.shutdown(wait=True, cancel_futures=True)  # the other workers stopped: notes final
+                begun, ended = _noted_trials(Path(started.name))
+                return _after_a_lost_worker(futures, begun, ended, broken, outcomes, progress, on_trial, flags)
             record_outcome(outcome, outcomes, progress, on_trial, flags)
     except KeyboardInterrupt:
         logger.warning(
@@ -151,14 +164,15 @@ def _run_pool(
 def _after_a_lost_worker(
     futures: dict[Future[TrialOutcome], int],
     begun: set[int],
+    ended: dict[int, TrialOutcome],
     broken: BrokenProcessPool,
     outcomes: list[TrialOutcome],
     progress: CampaignProgress,
     on_trial: Callable[[TrialOutcome], None] | None,
     flags: str,
 ) -> list[int]:
-    """A worker died: the trials that had begun fail (which of them crashed its worker cannot be
-    told), those finished count, the rest wait for a fresh pool."""
+    """A worker died: the trials that ended count, those that had begun and not ended fail (which of
+    them crashed its worker cannot be told), the rest wait for a fresh pool."""
     done = {outcome.seed for outcome in outcomes}
     waiting = []
     for future, seed in futures.items():
@@ -166,6 +180,8 @@ def _after_a_lost_worker(
             continue
         if future.done() and not future.cancelled() and future.exception() is None:
             record_outcome(future.result(), outcomes, progress, on_trial, flags)
+        elif seed in ended:
+            record_outcome(ended[seed], outcomes, progress, on_trial, flags)
         elif seed in begun:
             record_outcome(lost_trial(seed, str(broken)), outcomes, progress, on_trial, flags)
         else:
