@@ -17,8 +17,10 @@ from sila_labware.deployment.demo import run_demo
 from tests.helpers.sila_stack import DEFAULT_WORLD, start_stack
 
 LONG_ROW = DEFAULT_WORLD.parent / "long_row.yaml"
+UNUSUAL = DEFAULT_WORLD.parent / "unusual_benches.yaml"
+CARRIED_AROUND = (LONG_ROW, UNUSUAL)  # their tests carry a plate further than the demo does
 EXAMPLES = sorted(
-    path for path in DEFAULT_WORLD.parent.glob("*.yaml") if path not in (DEFAULT_WORLD, LONG_ROW)
+    path for path in DEFAULT_WORLD.parent.glob("*.yaml") if path not in (DEFAULT_WORLD, *CARRIED_AROUND)
 )
 # what the demo moves in each: the plate, from, to
 EXPECTED = {
@@ -27,13 +29,11 @@ EXPECTED = {
     "two_benches": ("plate_b", "bench_a/2", "bench_b/1"),
     "three_stations": ("dw_001", "sealer/1", "reader/2"),  # the deep-well plate
     "standing_benches": ("plate_001", "station_a/1", "station_b/1"),  # 0.90 m, no robot fields
-    "unusual_benches": ("plate_001", "low_bench/1", "high_bench/1"),  # the lowest and the highest bench
 }
 # long_row.yaml: reader/1 into the middle nest between two full ones, then to each end of the row
 ALONG_THE_ROW = (("reader", 1), ("plate_store", 3), ("plate_store", 6), ("plate_store", 1))
-UNUSUAL = DEFAULT_WORLD.parent / "unusual_benches.yaml"
 # low_bench (0.60 m, heading 0) -> high_bench (0.78 m, 90) -> back_bench (180) -> corner_bench (-135)
-# -> side_marker_bench (-90, its marker far right of the working pose)
+# -> side_marker_bench (-90, its marker far right of the working pose); the first leg is its demo
 AROUND = (
     ("low_bench", 1),
     ("high_bench", 1),
@@ -45,6 +45,7 @@ AROUND = (
 
 def test_every_example_world_has_a_transfer_here() -> None:
     assert sorted(path.stem for path in EXAMPLES) == sorted(EXPECTED)
+    assert all(world.exists() for world in CARRIED_AROUND)
 
 
 @pytest.mark.parametrize("world", EXAMPLES, ids=[path.stem for path in EXAMPLES])
