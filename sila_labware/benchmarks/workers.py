@@ -27,6 +27,7 @@ import tempfile
 from collections.abc import Callable
 from concurrent.futures import Future, ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TextIO
 
@@ -78,11 +79,20 @@ def _noted(trial: Callable[..., TrialOutcome], options: CampaignOptions, seed: i
     return outcome
 
 
-def _noted_trials(started_dir: Path) -> tuple[set[int], dict[int, TrialOutcome]]:
+@dataclass(frozen=True)
+class _Lost:
+    """What the workers had noted when one died: the trials begun, the outcomes of those that ended."""
+
+    begun: set[int]
+    ended: dict[int, TrialOutcome]
+    broken: BrokenProcessPool
+
+
+def _noted_trials(started_dir: Path, broken: BrokenProcessPool) -> _Lost:
     """The seeds whose trials began, and the outcomes of those that ended, as the workers noted them."""
     begun = {int(path.name) for path in started_dir.iterdir() if path.name.isdigit()}
     ended = {int(path.stem): pickle.loads(path.read_bytes()) for path in started_dir.glob("*.outcome")}
-    return begun, ended
+    return _Lost(begun, ended, broken)
 
 
 def lost_trial(trial_seed: int, why: str) -> TrialOutcome:
@@ -144,8 +154,8 @@ def _run_pool(
                 outcome = future.result()  # a worker's KeyboardInterrupt arrives here as one too
             except BrokenProcessPool as broken:
                 pool.shutdown(wait=True, cancel_futures=True)  # the other workers stopped: notes final
-                begun, ended = _noted_trials(Path(started.name))
-                return _after_a_lost_worker(futures, begun, ended, broken, outcomes, progress, on_trial, flags)
+                lost = _noted_trials(Path(started.name), broken)
+                return _after_a_lost_worker(futures, lost, outcomes, progress, on_trial, flags)
             record_outcome(outcome, outcomes, progress, on_trial, flags)
     except KeyboardInterrupt:
         logger.warning(
@@ -163,9 +173,7 @@ def _run_pool(
 
 def _after_a_lost_worker(
     futures: dict[Future[TrialOutcome], int],
-    begun: set[int],
-    ended: dict[int, TrialOutcome],
-    broken: BrokenProcessPool,
+    lost: _Lost,
     outcomes: list[TrialOutcome],
     progress: CampaignProgress,
     on_trial: Callable[[TrialOutcome], None] | None,
@@ -180,11 +188,11 @@ def _after_a_lost_worker(
             continue
         if future.done() and not future.cancelled() and future.exception() is None:
             record_outcome(future.result(), outcomes, progress, on_trial, flags)
-        elif seed in ended:
-            record_outcome(ended[seed], outcomes, progress, on_trial, flags)
-        elif seed in begun:
-            record_outcome(lost_trial(seed, str(broken)), outcomes, progress, on_trial, flags)
+        elif seed in lost.ended:
+            record_outcome(lost.ended[seed], outcomes, progress, on_trial, flags)
+        elif seed in lost.begun:
+            record_outcome(lost_trial(seed, str(lost.broken)), outcomes, progress, on_trial, flags)
         else:
             waiting.append(seed)
-    logger.warning("a worker died (%s): %d trial(s) go on in a fresh pool", broken, len(waiting))
+    logger.warning("a worker died (%s): %d trial(s) go on in a fresh pool", lost.broken, len(waiting))
     return sorted(waiting)
