@@ -159,8 +159,10 @@ class GlobalPlanner:
         """A path from the start pose (x, y, yaw) to the goal pose; raises PlanningError."""
         started = time.perf_counter()
         grid = self.static_map
+        # The start is where the robot stands: it may lie inside the footprint margin (a working pose
+        # 0.36 m from its bench shows 0.29 m on a 5 cm map), and it leaves by moving away.
         for what, (x, y, _) in (("goal", goal), ("start", start)):
-            if not grid.is_free(x, y) or not self.footprint.is_free(x, y):
+            if not grid.is_free(x, y) or (what == "goal" and not self.footprint.is_free(x, y)):
                 raise PlanningError(
                     f"the {what} ({x:.2f}, {y:.2f}) is inside an obstacle or closer than "
                     f"{BASE_RADIUS + FOOTPRINT_MARGIN_M:.2f} m to one"
@@ -205,6 +207,7 @@ class GlobalPlanner:
             directions = [yaw, yaw + math.pi]
         best: tuple[float, tuple[float, float], bool] | None = None
         step = self.static_map.resolution / 2
+        here = float(self.clearance[row, col])
         for direction in directions:
             dx, dy = math.cos(direction), math.sin(direction)
             if not self._arms_clear((x, y), direction):
@@ -212,7 +215,7 @@ class GlobalPlanner:
             distance = step
             while distance <= ESCAPE_MAX_M:
                 point = (x + dx * distance, y + dy * distance)
-                if not self.footprint.is_free(*point) or not self._arms_clear(point, direction):
+                if not self._base_clear(point, leaving, here) or not self._arms_clear(point, direction):
                     break
                 if self.inflated.is_free(*point):
                     if best is None or distance < best[0]:
@@ -233,6 +236,15 @@ class GlobalPlanner:
                 "(the folded arms)"
             )
         return best[1], best[2]
+
+    def _base_clear(self, point: tuple[float, float], leaving: bool, start_clearance: float) -> bool:
+        """The base may pass `point`: clear of the footprint margin, or (leaving a start inside it)
+        no nearer an obstacle than the start itself."""
+        if self.footprint.is_free(*point):
+            return True
+        row, col = self.static_map.cell_of(*point)
+        inside = self.static_map.inside(row, col)
+        return leaving and inside and float(self.clearance[row, col]) >= start_clearance
 
     # -- the grid search ------------------------------------------------------------------
     def _search_cell_near(self, point: tuple[float, float]) -> tuple[int, int] | None:

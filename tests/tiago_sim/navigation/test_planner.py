@@ -4,23 +4,27 @@ and goal inside the inflated zone."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from lab_description.world import DEFAULT_WORLD, load_world
 from lab_description.world_obstacles import KEEP_CLEAR_M
+from tiago_description.robot_model import BASE_RADIUS
 from tiago_sim.measuring.disturbances import DisturbanceLevels
 from tiago_sim.navigation.occupancy_map import Footprint, OccupancyMap, build_map
 from tiago_sim.navigation.plan_benchmark import measure
 from tiago_sim.navigation.planner import (
     ARM_SWEEP_RADIUS_M,
     ARMS_CLEAR_ABOVE_M,
+    FOOTPRINT_MARGIN_M,
     INFLATION_RADIUS_M,
     ROBOT_RADIUS_M,
     GlobalPlanner,
     PlanningError,
     hotel_sweep_radius,
+    world_planner,
 )
 
 BENCH_IN_THE_WAY = DEFAULT_WORLD.parent / "bench_in_the_way.yaml"
@@ -165,3 +169,21 @@ def test_the_obstacles_keep_clear_covers_the_planner_and_the_navigation_error() 
     """A POI the robot stops up to 3 sigma off (per axis) is still one the planner accepts."""
     three_sigma = 3 * DisturbanceLevels().navigation_xy_m
     assert KEEP_CLEAR_M >= INFLATION_RADIUS_M + three_sigma
+
+
+def test_a_start_inside_the_footprint_margin_leaves_backwards_and_never_nearer() -> None:
+    """Random layout 131126 (campaign at 3798aea): the robot stood 0.362 m from the washer's bench,
+    where it had worked (the loader keeps 0.370 m, less the final approach's error), and the 5 cm map
+    put it 0.29 m away, inside the base's 0.295 m margin: no path out. The robot stands there; it
+    leaves backwards, and no leg of the way goes nearer an obstacle than it stands."""
+    world = load_world(Path(__file__).resolve().parent / "fixtures" / "layout_131126.yaml")
+    planner = world_planner(world)
+    start = (1.2008, 2.6039, 0.6863)  # where localisation put it after the pick
+    row, col = planner.static_map.cell_of(*start[:2])
+    assert planner.clearance[row, col] < BASE_RADIUS + FOOTPRINT_MARGIN_M  # inside the margin on the map
+    reader = world.pois["reader_work"]
+    plan = planner.plan(start, (reader.x, reader.y, reader.yaw))
+    assert plan.reverse_first  # it backs away from the bench: it cannot turn there
+    assert clearance_along(planner, plan.waypoints) >= planner.clearance[row, col] - 1e-6
+    with pytest.raises(PlanningError, match=r"the goal \(1.20, 2.60\) is inside an obstacle or closer"):
+        planner.plan((reader.x, reader.y, reader.yaw), start)  # as a goal it is still refused
