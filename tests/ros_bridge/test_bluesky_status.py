@@ -162,7 +162,7 @@ def test_demo_without_the_task_servers_exits_1_naming_what_is_missing(
 ) -> None:
     world = Path(__file__).resolve().parents[2] / "lab_description" / "worlds" / "default.yaml"
     with caplog.at_level(logging.ERROR, logger="ros_bridge.bluesky.demo"):
-        # per server: a fresh participant discovers the echo server's navigate action well within
-        # 8 s on a busy machine (3 s once was not, under three test workers on two cores)
+        # per server: time for a fresh participant to discover the echo server's navigate action
+        # on a busy machine
         assert run_bluesky_demo(world, ready_timeout_s=8.0) == 1
     assert "action server /dock (Dock) not available" in caplog.text
