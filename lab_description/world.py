@@ -79,8 +79,11 @@ class Pose2D:
 
 STATION_PLACEMENT_FIELDS = ("standoff", "work_standoff", "lateral", "approach_height")
 MARKER_BOARD_SCALE = 1.4
-"""The marker's board is this many times the marker's side, square, standing on the bench top behind
-the marker (physics.scene builds it)."""
+"""The marker's board is this many times the marker's side wide, standing on the bench top behind
+the marker (physics.scene builds it; the skills keep the arm clear of it)."""
+MARKER_BOARD_THICKNESS = 0.01
+MARKER_BOARD_BEHIND = 0.006
+"""The board's middle lies this far behind the marker's face (m)."""
 
 
 @dataclass(frozen=True)
@@ -118,6 +121,16 @@ class Station:
     def marker_stand_height(self) -> float:
         """How far the marker's board reaches above the bench top (m)."""
         return self.marker_xyz[2] + self.marker_size * MARKER_BOARD_SCALE / 2
+
+    def marker_board_size(self) -> tuple[float, float, float]:
+        """The marker's board (m): its width and height in the marker's plane, and its thickness."""
+        return (self.marker_size * MARKER_BOARD_SCALE, self.marker_stand_height(), MARKER_BOARD_THICKNESS)
+
+    def T_marker_board(self) -> np.ndarray:
+        """The board's centre in the marker frame (x right, y up, z out of the face): it stands on the
+        bench top, behind the marker."""
+        up = self.marker_stand_height() / 2 - self.marker_xyz[2]
+        return tf.make_transform((0.0, up, -MARKER_BOARD_BEHIND))
 
     def top_height(self) -> float:
         """The highest point of the bench and what stands on it (the marker's board), above the floor."""

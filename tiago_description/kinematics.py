@@ -28,6 +28,7 @@ IK_POSITION_TOLERANCE = 5e-4  # m
 IK_ORIENTATION_TOLERANCE = 2e-3  # rad
 IK_STALL_ITERATIONS = 15  # a solve ends when its error has not dropped by IK_STALL_PROGRESS in this many
 IK_STALL_PROGRESS = 1e-6  # m (+ 0.1 m per rad)
+DISTINCT_SOLUTION_RAD = 0.1  # two IK solutions this close on every joint count as one
 
 
 @dataclass(frozen=True)
@@ -61,6 +62,10 @@ class RobotKinematics:
             else:  # continuous joint stored as (cos, sin)
                 q[joint.idx_q : joint.idx_q + 2] = (np.cos(value), np.sin(value))
         return q
+
+    def configuration(self, joint_positions: Mapping[str, float]) -> np.ndarray:
+        """pinocchio's q for the named joint positions; joints not given are taken at zero."""
+        return self._q(joint_positions)
 
     def forward(self, joint_positions: Mapping[str, float], frame: str) -> np.ndarray:
         """4x4 pose of ``frame`` in base_footprint; joints not given are taken at zero."""
@@ -128,6 +133,47 @@ class RobotKinematics:
         return IkResult(
             False, best.joint_positions, best.position_error_m, best.orientation_error_rad, restarts + 1
         )
+
+    def solutions(
+        self,
+        arm: str,
+        T_base_target: np.ndarray,
+        seed_positions: Mapping[str, float],
+        *,
+        use_torso: bool = False,
+        count: int = 4,
+        tries: int = 24,
+        seed: int = 0,
+    ) -> list[dict[str, float]]:
+        """Up to `count` different joint solutions for ``T_base_target`` (no two within
+        DISTINCT_SOLUTION_RAD on every joint), least joint travel from ``seed_positions`` first: the
+        seeded solve, then solves from `tries` random starts. Why: one joint-space move to the nearest
+        solution may sweep through something another solution passes clear of."""
+        names = robot_model.arm_joint_names(arm)
+        if use_torso:
+            names = ["torso_lift_joint", *names]
+        limits = [(self.lower[self.joint_index(n)], self.upper[self.joint_index(n)]) for n in names]
+        rng = np.random.default_rng(seed)
+        found: list[dict[str, float]] = []
+        for attempt in range(tries + 1):
+            start = dict(seed_positions)
+            if attempt:
+                start.update(
+                    {n: float(rng.uniform(low, high)) for n, (low, high) in zip(names, limits, strict=True)}
+                )
+            result = self.inverse(arm, T_base_target, start, use_torso=use_torso, restarts=0)
+            if result.success and all(
+                max(abs(result.joint_positions[n] - other[n]) for n in names) > DISTINCT_SOLUTION_RAD
+                for other in found
+            ):
+                found.append(result.joint_positions)
+                if len(found) >= count:
+                    break
+
+        def travel(joints: dict[str, float]) -> float:
+            return max(abs(value - seed_positions.get(name, value)) for name, value in joints.items())
+
+        return sorted(found, key=travel)
 
     def _solve(
         self, q: np.ndarray, indices: np.ndarray, frame_id: int, target: pin.SE3, max_iterations: int

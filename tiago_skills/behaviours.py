@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import logging
 import math
-import threading
 from collections.abc import Callable
 from typing import Any
 
@@ -23,11 +22,11 @@ from robot_port.execution import Execution
 from robot_port.hardware import RobotHardware
 from robot_port.types import ARM_SIDES, JointTrajectory
 from tiago_description import robot_model as rm
-from tiago_description.kinematics import RobotKinematics
 from tiago_description.motion_library import HOTEL_MOTIONS, MotionLibrary
 from tiago_description.transforms import make_transform
+from tiago_skills.arm_planning import ArmPlanning
 from tiago_skills.goal_run import ActionAbort, GoalRun
-from tiago_skills.tool_path import plan_tool_path, tool_trajectory
+from tiago_skills.tool_path import tool_trajectory
 
 log = logging.getLogger(__name__)
 
@@ -77,9 +76,7 @@ class RobotBehaviours:
         self.hotel_slots = hotel_slots
         self.motions = motions
         self.speed_scale = speed_scale
-        self._rng = np.random.default_rng(seed)  # IK restarts' seeds
-        self._kinematics = RobotKinematics()
-        self._kinematics_lock = threading.Lock()
+        self.planning = ArmPlanning(seed)
         self.grasp_flipped: dict[str, bool] = {}  # per arm: twin of the top-down grasp last used
         self.holding: dict[str, bool] = {}  # per arm: the last gripper command closed on a plate
 
@@ -183,20 +180,6 @@ class RobotBehaviours:
             run.follow(move_joints(targets, speed), span=span)
         return {}
 
-    def solve_ik(
-        self, arm: str, T_base_grasp: Any, seed_positions: dict[str, float], *, use_torso: bool = True
-    ) -> dict[str, float] | None:
-        """Joint targets for the grasping frame at T_base_grasp, or None when unreachable."""
-        with self._kinematics_lock:
-            result = self._kinematics.inverse(
-                arm, T_base_grasp, seed_positions, use_torso=use_torso, restarts=60
-            )
-        return dict(result.joint_positions) if result.success else None
-
-    def tool_pose(self, arm: str, joint_positions: dict[str, float]) -> np.ndarray:
-        with self._kinematics_lock:
-            return self._kinematics.forward(joint_positions, f"gripper_{arm}_grasping_frame")
-
     def grasp_twin(self, arm: str, T_base_grasp: np.ndarray, seed: dict[str, float]) -> np.ndarray:
         """A top-down grasp pose or its twin with the fingers swapped (half-turn about the approach).
 
@@ -208,7 +191,7 @@ class RobotBehaviours:
         order = [self.grasp_flipped.get(arm, False)] if self.holding.get(arm) else [False, True]
         travel = {}  # twin -> largest joint change to reach it (the slowest joint sets the pace)
         for flip in order:
-            joints = self.solve_ik(arm, twins[flip], seed)
+            joints = self.planning.solve_ik(arm, twins[flip], seed)
             if joints is not None:
                 travel[flip] = max(abs(value - seed.get(name, value)) for name, value in joints.items())
         if travel:
@@ -220,8 +203,7 @@ class RobotBehaviours:
         )
 
     def hotel_grasp_pose(self, slot: int, approach: bool, releasing: bool = False) -> np.ndarray:
-        with self._kinematics_lock:
-            T_base_slot = self._kinematics.forward({}, f"hotel_slot_{slot}")
+        T_base_slot = self.planning.frame_pose({}, f"hotel_slot_{slot}")
         return T_base_slot @ self.motions.hotel.T_slot_grasp(approach, releasing)
 
     def _tool_move(
@@ -254,7 +236,7 @@ class RobotBehaviours:
     ) -> None:
         """Down into a nest or hotel pocket: fast to CREEP_HEIGHT above it, then slowly the rest."""
         joints = run.read(lambda hardware: dict(hardware.joint_positions()))
-        height = self.tool_pose(arm, joints)[2, 3] - T_base_grasp[2, 3]
+        height = self.planning.tool_pose(arm, joints)[2, 3] - T_base_grasp[2, 3]
         low, high = span
         if height > CREEP_HEIGHT + 0.01:
             T_above = T_base_grasp.copy()
@@ -285,9 +267,8 @@ class RobotBehaviours:
         """The joint trajectory that moves the grasping frame along a straight line to T_base_grasp
         at up to `tool_speed` (m/s; the joints' limits cap it too); IK_FAILED naming the waypoint
         where no line exists."""
-        current = run.read(lambda hardware: hardware.joint_positions())
-        with self._kinematics_lock:
-            planned = plan_tool_path(self._kinematics, self._rng, arm, current, T_base_grasp, True, use_torso)
+        current = run.read(lambda hardware: dict(hardware.joint_positions()))
+        planned = self.planning.plan_line(arm, current, T_base_grasp, use_torso=use_torso)
         if isinstance(planned, str):
             raise ActionAbort(ErrorCodes.IK_FAILED, planned)
         return tool_trajectory(planned, tool_speed)
@@ -303,9 +284,7 @@ class RobotBehaviours:
         """
         log.info("no straight path to %s: moving in joint space", np.round(T_base_grasp[:3, 3], 3))
         seed = run.read(lambda hardware: dict(hardware.joint_positions()))
-        joints = self.solve_ik(arm, T_base_grasp, seed, use_torso=False) or self.solve_ik(
-            arm, T_base_grasp, seed
-        )
+        joints = self.planning.plan_joint_move(arm, seed, T_base_grasp)
         if joints is None:
             raise ActionAbort(
                 ErrorCodes.IK_FAILED, f"the {arm} arm cannot reach {np.round(T_base_grasp[:3, 3], 3)}"
@@ -314,7 +293,7 @@ class RobotBehaviours:
         run.follow(move_joints(joints, speed), span=span)
 
     def _over_slot(self, arm: str, joints: dict[str, float], slot: int, radius_m: float) -> bool:
-        tool = self.tool_pose(arm, joints)[:3, 3]
+        tool = self.planning.tool_pose(arm, joints)[:3, 3]
         return float(np.hypot(*(tool[:2] - self.hotel_grasp_pose(slot, True)[:2, 3]))) < radius_m
 
     def leave_hotel(self, run: GoalRun, arm: str) -> float:
@@ -322,7 +301,7 @@ class RobotBehaviours:
         joints = run.read(lambda hardware: dict(hardware.joint_positions()))
         for slot in range(1, self.hotel_slots + 1):
             if self._over_slot(arm, joints, slot, 0.05):
-                T_carry = self.tool_pose(arm, joints)
+                T_carry = self.planning.tool_pose(arm, joints)
                 T_carry[2, 3] = self.hotel_grasp_pose(slot, True)[2, 3] + self.motions.hotel.carry_height_m
                 self.straight_move(run, arm, T_carry, TOOL_SPEED_FREE, (0.0, 0.3))
                 return 0.3
@@ -333,7 +312,7 @@ class RobotBehaviours:
         height first; returns the progress used. The tool leaves a bench from a nest's approach pose,
         which clears everything on it."""
         joints = run.read(lambda hardware: dict(hardware.joint_positions()))
-        T_tool = self.tool_pose(arm, joints)
+        T_tool = self.planning.tool_pose(arm, joints)
         if T_tool[0, 3] <= BENCH_FRONT_X + BENCH_EDGE_MARGIN / 2:  # on the line ("Benchtop"), or behind it
             return 0.0
         T_front = T_tool.copy()
@@ -353,7 +332,7 @@ class RobotBehaviours:
         """Before the tool goes over a bench to a target higher than itself, rise straight up to the
         target's height where it is (in front of the bench); returns the progress used so far."""
         joints = run.read(lambda hardware: dict(hardware.joint_positions()))
-        T_tool = self.tool_pose(arm, joints)
+        T_tool = self.planning.tool_pose(arm, joints)
         if T_base_target[0, 3] <= BENCH_FRONT_X or T_tool[0, 3] > BENCH_FRONT_X + BENCH_EDGE_MARGIN:
             return first
         if T_tool[2, 3] >= T_base_target[2, 3] - 0.005:

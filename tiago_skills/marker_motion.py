@@ -11,7 +11,8 @@ the working pose in front of the nests, as the marker shows it.
 Steps: take an image (the hardware port) -> detect the marker (this thread) -> T_base_marker =
 T_base_optical @ T_optical_marker -> the nest frame from the world's site_in_marker, sub-position
 spacing and approach height -> the grasp pose in that frame (fingers down, closing across the
-plate's short side; the flipped twin if IK prefers it) -> a straight tool line (behaviours). A sighting is
+plate's short side; the flipped twin if IK prefers it) -> a way there clear of the marker's board
+(bench_route: a straight tool line where it is clear). A sighting is
 reused while the base has not moved: the marker is fixed to its station, so its pose in
 base_footprint holds whatever arms, torso and head do since (and the arm above the nest hides the
 marker from the head). Lives on: an rclpy executor thread (one goal at a time).
@@ -34,7 +35,13 @@ from tiago_description import transforms as tf
 from tiago_description.kinematics import RobotKinematics
 from tiago_description.motion_library import HotelGrasp
 from tiago_skills.base_alignment import align_base, working_pose
-from tiago_skills.behaviours import TOOL_SPEED_FREE, TOOL_SPEED_INTO_POCKET, RobotBehaviours
+from tiago_skills.behaviours import (
+    FLIP_ABOUT_APPROACH,
+    TOOL_SPEED_FREE,
+    TOOL_SPEED_INTO_POCKET,
+    RobotBehaviours,
+)
+from tiago_skills.bench_route import BenchRoute, board_box, held_plate_box
 from tiago_skills.goal_run import ActionAbort, GoalRun
 from tiago_skills.perception.aruco import detect_marker
 from tiago_skills.perception.site_frames import nest_in_base
@@ -74,6 +81,8 @@ class MarkerMotionBehaviour:
         self.world = world
         self.behaviours = behaviours
         self.grasp = grasp
+        self.route = BenchRoute(behaviours)
+        self.held_plate = held_plate_box(list(world.labware_types.values()), grasp)
         self.kinematics = RobotKinematics()
         self._lock = threading.Lock()
         self.last_sighting: MarkerSighting | None = None
@@ -150,7 +159,7 @@ class MarkerMotionBehaviour:
         reach at waypoint 12 of 34, though the nest itself is reachable; the contact watch still stops a
         joint-space move that touches anything."""
         joints = run.read(lambda hardware: dict(hardware.joint_positions()))
-        tool = self.behaviours.tool_pose(arm, joints)[:3, 3]
+        tool = self.behaviours.planning.tool_pose(arm, joints)[:3, 3]
         return float(np.hypot(*(tool[:2] - T_base_target[:2, 3]))) > LINE_ONLY_RADIUS_M
 
     def __call__(self, run: GoalRun, goal: Any) -> dict:
@@ -213,14 +222,21 @@ class MarkerMotionBehaviour:
                 self.behaviours.into_pocket(run, arm, T_base_target, (first, 1.0))
                 return {"marker_in_base": marker_in_base}
             first = self.behaviours.rise_before_bench(run, arm, T_base_target, first)
-            try:
-                self.behaviours.straight_move(run, arm, T_base_target, speed, (first, 1.0))
-            except ActionAbort as abort:
-                if abort.code != ErrorCodes.IK_FAILED or not self._may_leave_the_line(
-                    run, arm, T_base_target
-                ):
-                    raise
-                self.behaviours.joint_space_move(run, arm, T_base_target, (first, 1.0))
+            holding = self.behaviours.holding.get(arm, False)
+            # An empty gripper may come down as either twin: the other one may have a clear way.
+            targets = [T_base_target] if holding else [T_base_target, T_base_target @ FLIP_ABOUT_APPROACH]
+            reached = self.route.move(
+                run,
+                arm,
+                targets,
+                speed,
+                (first, 1.0),
+                [board_box(station, sighting.T_base_marker)],
+                self.held_plate if holding else None,
+                may_leave_line=self._may_leave_the_line(run, arm, T_base_target),
+            )
+            if reached:
+                self.behaviours.grasp_flipped[arm] = not self.behaviours.grasp_flipped.get(arm, False)
         except ActionAbort as abort:
             abort.extra = {"marker_in_base": marker_in_base}
             raise

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pybullet as p
 
-from lab_description.world import MARKER_BOARD_SCALE, Obstacle, Station, World
+from lab_description.world import Obstacle, Station, World
 from labware_model.holders import HotelSlot, Nest
 from labware_model.labware import LabwareType
 from tiago_description import transforms as tf
@@ -134,11 +134,9 @@ def _build_marker(client: int, station: Station, scene: Scene) -> None:
     T_world_marker = station.T_world_marker()
     T_world_tile = T_world_marker @ tf.make_transform((0, 0, 0.0008))
     scene.markers[station.name] = marker_visual(client, station.marker_id, station.marker_size, T_world_tile)
-    board = station.marker_size * MARKER_BOARD_SCALE
-    stand_height = station.marker_stand_height()
-    T_world_board = T_world_marker @ tf.make_transform((0, stand_height / 2 - station.marker_xyz[2], -0.006))
+    T_world_board = T_world_marker @ station.T_marker_board()
     scene.marker_stands[station.name] = _static_box(
-        client, (board, stand_height, 0.01), T_world_board, [0.95, 0.95, 0.95, 1]
+        client, station.marker_board_size(), T_world_board, [0.95, 0.95, 0.95, 1]
     )
 
 
