@@ -1,19 +1,22 @@
-"""The arm's way from in front of a bench to above a nest, clear of the station's marker board.
+"""The arm's way from in front of a bench to above a nest, clear of the station's marker board and bench.
 
 Why: the marker stands on a board beside the row (furniture as a lab has it: 2 to 8 cm beyond the end
 nest's brackets), and the arm's usual ways to the end nest beside it, a straight tool line or one
 joint-space move, swept a finger, the wrist or a held plate into the board (random layouts 132035,
-132040, 132016). The ways are planned first and checked against the board, placed where the marker
-is seen, with the robot model's collision shapes (`tiago_description.arm_clearance`); the first that
-keeps BOARD_CLEARANCE_M runs:
+132040, 132016); a joint-space move also dipped a finger into the bench top. The ways are planned
+first and checked against the board and the bench, placed where the marker is seen, with the robot
+model's collision shapes (`tiago_description.arm_clearance`); the first that keeps WAY_CLEARANCE_M
+runs, tried in this order, each to the grasp and then to its twin with the fingers swapped (an empty
+gripper only: a held plate keeps its orientation):
 
 1. the straight tool line (the arm alone, else with the torso);
-2. one joint-space move, where the tool may leave the line (not from the column above the nest);
-3. via the nest's front: to the pose in line with the nest on the bench's front line (`BENCH_FRONT_X`)
-   at the target's height, then straight in over the bench, perpendicular to its edge, where nothing
-   but the nest's own column is passed.
+2. a joint-space move, to each of several IK solutions;
+3. via a pose in front of the bench, then straight in: in line with the nest on the bench's front line
+   (`BENCH_FRONT_X`), or where the tool is, turned as at the target. The way there is a straight line
+   or a joint-space move, the line in planned backwards from the target's IK solutions.
 
-None clear: IK_FAILED naming each way's nearest pass, before anything moves. Lives on the goal's thread.
+None clear: IK_FAILED naming each way's nearest pass, before anything moves. From in or just above
+the nest the tool only moves straight (marker_motion), and no way is chosen. Lives on the goal's thread.
 """
 
 from __future__ import annotations
@@ -38,10 +41,10 @@ from tiago_skills.tool_path import tool_trajectory
 
 log = logging.getLogger(__name__)
 
-BOARD_CLEARANCE_M = 0.012
-"""The least distance a planned way keeps between the arm, its gripper or a held plate and the marker's
-board (m): the board's pose comes from the marker seen (a few mm), the arm follows its trajectory to
-a few mm, and the contacts seen were 0.5 to 2.3 mm deep."""
+WAY_CLEARANCE_M = 0.012
+"""The least distance a planned way keeps between the arm, its gripper or a held plate and the
+marker's board or the bench (m): their poses come from the marker seen (a few mm), the arm follows
+its trajectory to a few mm, and the contacts seen were 0.5 to 2.3 mm deep."""
 FRONT_DETOUR_MIN_M = 0.05
 """The way via the nest's front is tried only for a target at least this far beyond the front line."""
 
@@ -78,6 +81,22 @@ def board_box(station: Station, T_base_marker_seen: np.ndarray) -> Box:
     )
 
 
+def bench_box(station: Station, T_base_marker_seen: np.ndarray) -> Box:
+    """The station's bench in base_footprint, placed where the marker is seen: a joint-space move
+    dipped a finger 1.6 mm into the bench top on its way to a nest (test_bench_route)."""
+    T_base_marker = upright_marker(T_base_marker_seen, station.T_table_marker())
+    depth, width, height = station.table_size
+    T_base_middle = (
+        T_base_marker @ tf.invert(station.T_table_marker()) @ tf.make_transform((0.0, 0.0, -height / 2))
+    )
+    return Box(f"{station.name} bench", (depth, width, height), T_base_middle)
+
+
+def station_boxes(station: Station, T_base_marker_seen: np.ndarray) -> list[Box]:
+    """What a way to a nest must keep clear of: the station's marker board and its bench."""
+    return [board_box(station, T_base_marker_seen), bench_box(station, T_base_marker_seen)]
+
+
 def held_plate_box(labware_types: list[LabwareType], grasp: HotelGrasp) -> HeldBox:
     """The largest plate the lab has, as the gripper holds it: the grasping frame's x points down
     into the plate (its bottom `grasp_height_m` below the frame), y across its short side, z along its
@@ -103,43 +122,59 @@ class BenchRoute:
         span: tuple[float, float],
         boxes: list[Box],
         held: HeldBox | None,
-        may_leave_line: bool,
     ) -> int:
         """Move the grasping frame to one of `targets` (the same grasp's twins, preferred first) by the
-        first clear way; returns the index of the target reached."""
+        first clear way (`plan`); returns the index of the target reached."""
         start = run.read(lambda hardware: dict(hardware.joint_positions()))
+        index, way = self.plan(arm, start, targets, tool_speed, boxes, held)
+        low, high = span
+        count = len(way.trajectories)
+        for number, trajectory in enumerate(way.trajectories):
+            part = (low + (high - low) * number / count, low + (high - low) * (number + 1) / count)
+            run.follow(lambda hardware, t=trajectory: hardware.follow_joint_trajectory(t), span=part)
+        return index
+
+    def plan(
+        self,
+        arm: str,
+        start: dict[str, float],
+        targets: list[np.ndarray],
+        tool_speed: float,
+        boxes: list[Box],
+        held: HeldBox | None,
+    ) -> tuple[int, Way]:
+        """The first way from `start` (all joint readings) to one of `targets` that keeps
+        WAY_CLEARANCE_M from `boxes`, with the target's index; IK_FAILED naming every way tried."""
         tried: list[str] = []
-        for index, way in self._ways(arm, start, targets, tool_speed, may_leave_line):
+        for index, way in self.ways(arm, start, targets, tool_speed):
             if isinstance(way, str):
                 tried.append(way)
                 continue
             nearest = self.behaviours.planning.clearance(arm, start, list(way.path), boxes, held)
-            if nearest.distance_m < BOARD_CLEARANCE_M:
+            if nearest.distance_m < WAY_CLEARANCE_M:
                 tried.append(f"{way.name}: {nearest.describe()} at {nearest.index + 1} of {len(way.path)}")
                 continue
             if tried:
                 where = np.round(targets[index][:3, 3], 3)
                 log.info("%s to %s (%s); not: %s", way.name, where, nearest.describe(), "; ".join(tried))
-            self._run(run, way, span)
-            return index
+            return index, way
         raise ActionAbort(
             ErrorCodes.IK_FAILED,
-            f"no way to {np.round(targets[0][:3, 3], 3)} keeps {BOARD_CLEARANCE_M * 1000:.0f} mm from "
-            f"the marker board: {'; '.join(tried)}",
+            f"no way to {np.round(targets[0][:3, 3], 3)} keeps {WAY_CLEARANCE_M * 1000:.0f} mm from "
+            f"the marker board and the bench: {'; '.join(tried)}",
         )
 
-    def _ways(
-        self, arm: str, start: dict[str, float], targets: list[np.ndarray], speed: float, may_leave_line: bool
+    def ways(
+        self, arm: str, start: dict[str, float], targets: list[np.ndarray], speed: float
     ) -> Iterator[tuple[int, Way | str]]:
         """The ways in the order they are tried, each planned only when the ones before were not clear:
         straight lines, then joint-space moves, then via a pose in front of the bench, each to every
         target in turn."""
         for index, T_target in enumerate(targets):
             yield index, self._line("straight line", arm, start, T_target, speed)
-        if may_leave_line:
-            for index, T_target in enumerate(targets):
-                for way in self._joint_moves("joint-space move", arm, start, T_target):
-                    yield index, way
+        for index, T_target in enumerate(targets):
+            for way in self._joint_moves("joint-space move", arm, start, T_target):
+                yield index, way
         T_tool = self.behaviours.planning.tool_pose(arm, start)
         for index, T_target in enumerate(targets):
             if T_target[0, 3] - BENCH_FRONT_X < FRONT_DETOUR_MIN_M:
@@ -149,7 +184,7 @@ class BenchRoute:
             T_turned = T_target.copy()  # where the tool is, turned as at the target
             T_turned[:3, 3] = T_tool[:3, 3]
             for name, T_via in (("via the front", T_front), ("turned first", T_turned)):
-                for way in self._via(name, arm, start, T_via, T_target, speed, may_leave_line):
+                for way in self._via(name, arm, start, T_via, T_target, speed):
                     yield index, way
 
     def _via(
@@ -160,10 +195,9 @@ class BenchRoute:
         T_via: np.ndarray,
         T_target: np.ndarray,
         speed: float,
-        may_leave_line: bool,
     ) -> Iterator[Way | str]:
-        """Via a pose in front of the bench, then straight to the target: a straight line to it, or
-        (where the tool may leave the line) a joint-space move to it. The line in is planned backwards
+        """Via a pose in front of the bench, then straight to the target: a straight line to it, or a
+        joint-space move to it. The line in is planned backwards
         from each of the target's IK solutions, so it lies in a branch that reaches the target (a line
         planned forwards from a joint-space move's end ran into a joint limit at once)."""
         first = self._line(name, arm, start, T_via, speed)
@@ -172,8 +206,6 @@ class BenchRoute:
         else:
             second = self._line(name, arm, first.end, T_target, speed)
             yield second if isinstance(second, str) else first.then(second)
-        if not may_leave_line:
-            return
         for goal in self.behaviours.planning.joint_move_goals(arm, start, T_target):
             out = self._line(name, arm, {**start, **goal}, T_via, speed)
             if isinstance(out, str):
@@ -218,10 +250,3 @@ class BenchRoute:
             }
             path = tuple({**start, **configuration} for configuration in joint_path(start, moved))
             yield Way(name, (JointTrajectory((moved,), speed),), path)
-
-    def _run(self, run: GoalRun, way: Way, span: tuple[float, float]) -> None:
-        low, high = span
-        count = len(way.trajectories)
-        for index, trajectory in enumerate(way.trajectories):
-            part = (low + (high - low) * index / count, low + (high - low) * (index + 1) / count)
-            run.follow(lambda hardware, t=trajectory: hardware.follow_joint_trajectory(t), span=part)

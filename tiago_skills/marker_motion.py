@@ -41,7 +41,7 @@ from tiago_skills.behaviours import (
     TOOL_SPEED_INTO_POCKET,
     RobotBehaviours,
 )
-from tiago_skills.bench_route import BenchRoute, board_box, held_plate_box
+from tiago_skills.bench_route import BenchRoute, held_plate_box, station_boxes
 from tiago_skills.goal_run import ActionAbort, GoalRun
 from tiago_skills.perception.aruco import detect_marker
 from tiago_skills.perception.site_frames import nest_in_base
@@ -152,15 +152,14 @@ class MarkerMotionBehaviour:
             return T_base_site
         return T_base_site @ tf.from_planar(*shift)
 
-    def _may_leave_the_line(self, run: GoalRun, arm: str, T_base_target: np.ndarray) -> bool:
-        """Whether a move to the site's approach pose may go in joint space where no straight line has
-        IK: from anywhere but straight below it (a tool in the nest, or just out of it, must rise
-        straight). From the arm-to-bench pose to the far nest of a 4-nest row the line left the arm's
-        reach at waypoint 12 of 34, though the nest itself is reachable; the contact watch still stops a
-        joint-space move that touches anything."""
+    def _in_the_column(self, run: GoalRun, arm: str, T_base_target: np.ndarray) -> bool:
+        """Whether the tool is in the column above the nest (in the nest, or just out of it): from
+        there it only rises or sinks straight; from anywhere else it comes by the first clear way
+        (bench_route), which may leave the line: from the arm-to-bench pose to the far nest of a 4-nest
+        row the line left the arm's reach at waypoint 12 of 34, though the nest itself is reachable."""
         joints = run.read(lambda hardware: dict(hardware.joint_positions()))
         tool = self.behaviours.planning.tool_pose(arm, joints)[:3, 3]
-        return float(np.hypot(*(tool[:2] - T_base_target[:2, 3]))) > LINE_ONLY_RADIUS_M
+        return float(np.hypot(*(tool[:2] - T_base_target[:2, 3]))) <= LINE_ONLY_RADIUS_M
 
     def __call__(self, run: GoalRun, goal: Any) -> dict:
         arm = self.behaviours.arm_of(goal.arm)
@@ -222,6 +221,9 @@ class MarkerMotionBehaviour:
                 self.behaviours.into_pocket(run, arm, T_base_target, (first, 1.0))
                 return {"marker_in_base": marker_in_base}
             first = self.behaviours.rise_before_bench(run, arm, T_base_target, first)
+            if self._in_the_column(run, arm, T_base_target):
+                self.behaviours.straight_move(run, arm, T_base_target, speed, (first, 1.0))
+                return {"marker_in_base": marker_in_base}
             holding = self.behaviours.holding.get(arm, False)
             # An empty gripper may come down as either twin: the other one may have a clear way.
             targets = [T_base_target] if holding else [T_base_target, T_base_target @ FLIP_ABOUT_APPROACH]
@@ -231,9 +233,8 @@ class MarkerMotionBehaviour:
                 targets,
                 speed,
                 (first, 1.0),
-                [board_box(station, sighting.T_base_marker)],
+                station_boxes(station, sighting.T_base_marker),
                 self.held_plate if holding else None,
-                may_leave_line=self._may_leave_the_line(run, arm, T_base_target),
             )
             if reached:
                 self.behaviours.grasp_flipped[arm] = not self.behaviours.grasp_flipped.get(arm, False)
