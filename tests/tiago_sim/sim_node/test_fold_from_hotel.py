@@ -60,7 +60,7 @@ def goal_run(hardware: RecordingHardware) -> GoalRun:
     return GoalRun(handle, PlayMotion.Feedback, hardware)
 
 
-def behaviours() -> RobotBehaviours:
+def behaviours(seed: int | None = None) -> RobotBehaviours:
     return RobotBehaviours(
         poi_pose=lambda _name: None,
         poi_names=list,
@@ -68,6 +68,7 @@ def behaviours() -> RobotBehaviours:
         hotel_slots=2,
         motions=load_motions(),
         speed_scale=lambda: 1.0,
+        seed=seed,
     )
 
 
