@@ -91,7 +91,7 @@ def test_tuck_over_the_hotel_rises_to_the_carry_height_first(slot: int) -> None:
     (kind, carry_joints), *rest = hardware.started
     expected = robot.hotel_grasp_pose(slot, approach=True)[2, 3] + robot.motions.hotel.carry_height_m
     assert kind == "move_tool"
-    assert robot.tool_pose(ARM, {**hardware.joints, **carry_joints})[2, 3] == pytest.approx(
+    assert robot.planning.tool_pose(ARM, {**hardware.joints, **carry_joints})[2, 3] == pytest.approx(
         expected, abs=1e-3
     )
     assert [kind for kind, _ in rest] == ["move_joints"] * len(robot.motions.frames_for("Tuck", ARM))
@@ -125,8 +125,8 @@ def test_leaving_a_bench_goes_straight_back_to_its_front_line_first(motion: str)
     robot.play_motion(goal_run(hardware), SimpleNamespace(arm=ARM, motion_name=motion, hotel_slot=1))
     (kind, back), *_rest = hardware.started
     assert kind in ("move_tool", "move_joints")  # straight if the arm can, else one short joint move
-    start = robot.tool_pose(ARM, joints_over_a_nest(0.49, -0.20, 0.95))
-    front = robot.tool_pose(ARM, {**joints_over_a_nest(0.49, -0.20, 0.95), **back})
+    start = robot.planning.tool_pose(ARM, joints_over_a_nest(0.49, -0.20, 0.95))
+    front = robot.planning.tool_pose(ARM, {**joints_over_a_nest(0.49, -0.20, 0.95), **back})
     assert front[0, 3] == pytest.approx(BENCH_FRONT_X, abs=1e-3)
     assert front[1:3, 3] == pytest.approx(start[1:3, 3], abs=1e-3)  # level, straight back
     assert BENCH_FRONT_X + OPEN_FINGER_REACH < WORKING_CLEARANCE  # the open fingers clear the edge
@@ -136,12 +136,12 @@ def test_towards_a_nest_higher_than_the_tool_the_tool_rises_in_front_of_the_benc
     robot = behaviours()
     bench = benchtop_joints()
     hardware = RecordingHardware(bench)
-    start = robot.tool_pose(ARM, bench)
+    start = robot.planning.tool_pose(ARM, bench)
     target = make_transform((0.49, -0.20, 0.95)) @ robot.motions.hotel.T_slot_grasp(approach=False)
     used = robot.rise_before_bench(goal_run(hardware), ARM, target, 0.1)
     assert used > 0.1
     ((kind, up),) = hardware.started
-    risen = robot.tool_pose(ARM, {**bench, **up})
+    risen = robot.planning.tool_pose(ARM, {**bench, **up})
     assert kind == "move_tool" and risen[2, 3] == pytest.approx(target[2, 3], abs=1e-3)
     assert risen[:2, 3] == pytest.approx(start[:2, 3], abs=1e-3)  # straight up where it stood
     low = make_transform((0.49, -0.20, 0.80)) @ robot.motions.hotel.T_slot_grasp(approach=False)
