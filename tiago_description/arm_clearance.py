@@ -11,6 +11,7 @@ Pure computation (pinocchio with coal); one instance per thread, like `RobotKine
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
@@ -65,8 +66,15 @@ class Clearance:
         return f"{self.link} {self.distance_m * 1000:.0f} mm from {self.obstacle}"
 
 
+BODY_LINKS_SKIPPED = ("1", "2")
+"""The arm's shoulder links (1, 2) sit on the torso by design; from link 3 on, the arm and its gripper are
+checked against the rest of the robot (torso, head, base, hotel, the other arm), 10 cm or more apart
+in "Benchtop"."""
+
+
 class ArmClearance:
-    """Distances from one arm's collision shapes to boxes, over a path of joint configurations."""
+    """Distances from one arm's collision shapes to boxes (and, asked, to the rest of the robot), over
+    a path of joint configurations."""
 
     def __init__(self, kinematics: RobotKinematics) -> None:
         self.kinematics = kinematics
@@ -81,27 +89,41 @@ class ArmClearance:
         path: Iterable[Mapping[str, float]],
         boxes: Sequence[Box],
         held: HeldBox | None = None,
+        body: bool = False,
     ) -> Clearance:
         """The least clearance over `path` (joint positions per configuration, each over `start`, the
-        full readings), between `arm`'s links, gripper and `held` and `boxes`."""
-        if not boxes:
-            return Clearance(math.inf)
+        full readings), between `arm`'s links, gripper and `held` and `boxes` (and with `body`, the
+        rest of the robot)."""
+        scene = self.scene(arm, boxes, held, body)
+        best = Clearance(math.inf)
+        base = dict(start)
+        for index, configuration in enumerate(path):
+            nearest = scene.nearest(self.kinematics.configuration({**base, **configuration}))
+            if nearest.distance_m < best.distance_m:
+                best = dataclasses.replace(nearest, index=index)
+        return best
+
+    def scene(self, arm: str, boxes: Sequence[Box], held: HeldBox | None = None, body: bool = False) -> Scene:
+        """The collision pairs to check for `arm` (its links, gripper and `held` against `boxes`, and
+        with `body` against the rest of the robot), to ask for many configurations."""
         model = self.kinematics.model
         geometry = pin.GeometryModel()
-        moving = [
-            geometry.addGeometryObject(obj)
-            for obj in self._geometry.geometryObjects
-            if obj.name.startswith((f"arm_{arm}_", f"gripper_{arm}_"))
-        ]
+        arm_prefixes = (f"arm_{arm}_", f"gripper_{arm}_")
+        moving, robot = [], []
+        for obj in self._geometry.geometryObjects:
+            index = geometry.addGeometryObject(obj)
+            if obj.name.startswith(arm_prefixes):
+                if not obj.name.startswith(tuple(f"arm_{arm}_{n}_" for n in BODY_LINKS_SKIPPED)):
+                    moving.append(index)
+                elif not body:
+                    moving.append(index)
+            else:
+                robot.append(index)
         if held is not None:
             frame = model.frames[model.getFrameId(f"gripper_{arm}_grasping_frame")]
             placement = frame.placement * pin.SE3(np.asarray(held.T_grasp_box, dtype=float))
-            shape = _fcl.Box(*held.size)
-            moving.append(
-                geometry.addGeometryObject(
-                    pin.GeometryObject("held plate", frame.parentJoint, placement, shape)
-                )
-            )
+            plate = pin.GeometryObject("held plate", frame.parentJoint, placement, _fcl.Box(*held.size))
+            moving.append(geometry.addGeometryObject(plate))
         fixed = [
             geometry.addGeometryObject(
                 pin.GeometryObject(
@@ -111,24 +133,29 @@ class ArmClearance:
             for box in boxes
         ]
         for a in moving:
-            for b in fixed:
+            for b in fixed + (robot if body else []):
                 geometry.addCollisionPair(pin.CollisionPair(a, b))
-        data = pin.GeometryData(geometry)
-        model_data = model.createData()
-        best = Clearance(math.inf)
-        base = dict(start)
-        for index, configuration in enumerate(path):
-            q = self.kinematics.configuration({**base, **configuration})
-            pin.computeDistances(model, model_data, geometry, data, q)
-            for pair, result in zip(geometry.collisionPairs, data.distanceResults, strict=True):
-                if result.min_distance < best.distance_m:
-                    best = Clearance(
-                        float(result.min_distance),
-                        geometry.geometryObjects[pair.first].name,
-                        geometry.geometryObjects[pair.second].name,
-                        index,
-                    )
-        return best
+        return Scene(model, geometry)
+
+
+class Scene:
+    """Collision pairs of one arm against what it must not touch, asked per configuration (pinocchio q)."""
+
+    def __init__(self, model: pin.Model, geometry: pin.GeometryModel) -> None:
+        self.model = model
+        self.geometry = geometry
+        self._data = model.createData()
+        self._geometry_data = pin.GeometryData(geometry)
+
+    def nearest(self, q: np.ndarray) -> Clearance:
+        if len(self.geometry.collisionPairs) == 0:
+            return Clearance(math.inf)
+        pin.computeDistances(self.model, self._data, self.geometry, self._geometry_data, q)
+        distances = [result.min_distance for result in self._geometry_data.distanceResults]
+        at = int(np.argmin(distances))
+        pair = self.geometry.collisionPairs[at]
+        names = self.geometry.geometryObjects
+        return Clearance(float(distances[at]), names[pair.first].name, names[pair.second].name)
 
 
 def joint_path(start: Mapping[str, float], goal: Mapping[str, float]) -> list[dict[str, float]]:

@@ -14,6 +14,7 @@ import numpy as np
 
 from tiago_description.arm_clearance import ArmClearance, Box, Clearance, HeldBox
 from tiago_description.kinematics import RobotKinematics
+from tiago_skills.joint_rrt import plan_around
 from tiago_skills.tool_path import plan_tool_path
 
 
@@ -84,3 +85,44 @@ class ArmPlanning:
 
     def tool_pose(self, arm: str, joint_positions: dict[str, float]) -> np.ndarray:
         return self.frame_pose(joint_positions, f"gripper_{arm}_grasping_frame")
+
+    def way_around(
+        self,
+        arm: str,
+        start: dict[str, float],
+        goals: list[dict[str, float]],
+        boxes: list[Box],
+        held: HeldBox | None,
+        clearance_m: float,
+    ) -> list[dict[str, float]] | None:
+        """Joint waypoints from `start` to one of `goals` (IK solutions, the same joints each) that keep
+        `clearance_m` from `boxes` and from the rest of the robot (`joint_rrt`), or None. Where the start
+        itself is nearer than that (it stands where an earlier motion left it), the way keeps what the
+        start keeps, less 2 mm."""
+        if not goals:
+            return None
+        names = list(goals[0])
+        with self._lock:
+            scene = self._clearance.scene(arm, boxes, held, body=True)
+            kinematics = self._kinematics
+            limits = np.array(
+                [
+                    (kinematics.lower[kinematics.joint_index(n)], kinematics.upper[kinematics.joint_index(n)])
+                    for n in names
+                ]
+            )
+            least = min(clearance_m, scene.nearest(kinematics.configuration(start)).distance_m - 0.002)
+
+            def is_free(x: np.ndarray) -> bool:
+                q = kinematics.configuration({**start, **dict(zip(names, x.tolist(), strict=True))})
+                return scene.nearest(q).distance_m >= least
+
+            path = plan_around(
+                is_free,
+                np.array([start[n] for n in names]),
+                [np.array([goal[n] for n in names]) for goal in goals],
+                limits[:, 0],
+                limits[:, 1],
+                self._rng,
+            )
+        return None if path is None else [dict(zip(names, x.tolist(), strict=True)) for x in path]

@@ -13,7 +13,8 @@ gripper only: a held plate keeps its orientation):
 2. a joint-space move, to each of several IK solutions;
 3. via a pose in front of the bench, then straight in: in line with the nest on the bench's front line
    (`BENCH_FRONT_X`), or where the tool is, turned as at the target. The way there is a straight line
-   or a joint-space move, the line in planned backwards from the target's IK solutions.
+   or a joint-space move, the line in planned backwards from the target's IK solutions;
+4. around: a joint-space way searched around the boxes and the robot's own body (`joint_rrt`).
 
 None clear: IK_FAILED naming each way's nearest pass, before anything moves. From in or just above
 the nest the tool only moves straight (marker_motion), and no way is chosen. Lives on the goal's thread.
@@ -21,6 +22,7 @@ the nest the tool only moves straight (marker_motion), and no way is chosen. Liv
 
 from __future__ import annotations
 
+import itertools
 import logging
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -146,7 +148,7 @@ class BenchRoute:
         """The first way from `start` (all joint readings) to one of `targets` that keeps
         WAY_CLEARANCE_M from `boxes`, with the target's index; IK_FAILED naming every way tried."""
         tried: list[str] = []
-        for index, way in self.ways(arm, start, targets, tool_speed):
+        for index, way in self.ways(arm, start, targets, tool_speed, boxes, held):
             if isinstance(way, str):
                 tried.append(way)
                 continue
@@ -165,7 +167,13 @@ class BenchRoute:
         )
 
     def ways(
-        self, arm: str, start: dict[str, float], targets: list[np.ndarray], speed: float
+        self,
+        arm: str,
+        start: dict[str, float],
+        targets: list[np.ndarray],
+        speed: float,
+        boxes: list[Box],
+        held: HeldBox | None,
     ) -> Iterator[tuple[int, Way | str]]:
         """The ways in the order they are tried, each planned only when the ones before were not clear:
         straight lines, then joint-space moves, then via a pose in front of the bench, each to every
@@ -186,6 +194,8 @@ class BenchRoute:
             for name, T_via in (("via the front", T_front), ("turned first", T_turned)):
                 for way in self._via(name, arm, start, T_via, T_target, speed):
                     yield index, way
+        for index, T_target in enumerate(targets):
+            yield index, self._around(arm, start, T_target, boxes, held)
 
     def _via(
         self,
@@ -214,6 +224,21 @@ class BenchRoute:
             inward = out.reversed({**start, **goal}, speed)
             for way in self._joint_moves(name, arm, start, inward.path[0], exact=True):
                 yield way if isinstance(way, str) else way.then(inward)
+
+    def _around(
+        self, arm: str, start: dict[str, float], T_target: np.ndarray, boxes: list[Box], held: HeldBox | None
+    ) -> Way | str:
+        """A joint-space way around the boxes and the robot's own body (`joint_rrt`)."""
+        name = "around"
+        goals = self.behaviours.planning.joint_move_goals(arm, start, T_target)
+        points = self.behaviours.planning.way_around(arm, start, goals, boxes, held, WAY_CLEARANCE_M)
+        if points is None:
+            return f"{name}: none found"
+        speed = self.behaviours.speed_scale() * self.behaviours.motions.speed_scale
+        path: list[dict[str, float]] = []
+        for a, b in itertools.pairwise([start, *points[1:]]):
+            path.extend({**start, **configuration} for configuration in joint_path(a, b))
+        return Way(name, (JointTrajectory(tuple(points[1:]), speed),), tuple(path))
 
     def _line(
         self, name: str, arm: str, start: dict[str, float], T_target: np.ndarray, speed: float
