@@ -232,6 +232,24 @@ def top_down_grasp(position: np.ndarray, yaw: float) -> np.ndarray:
     return transform
 
 
+HEAD_LIMIT_MARGIN_RAD = math.radians(1.0)
+
+
+def within_head_limits(aim: dict[str, float]) -> dict[str, float]:
+    """Pan and tilt held HEAD_LIMIT_MARGIN_RAD inside the head's limits: the camera's half field of view
+    (18 deg vertically) keeps a target a few degrees beyond them in the image, and a goal beyond a limit
+    never arrives (a marker low and near asked for -60.2 deg of tilt: MOTION_FAILED, layout 134099)."""
+    limits = {f"{joint.name}_joint": joint.limits_deg for joint in robot_model.HEAD_JOINTS}
+    out = dict(aim)
+    for name, (low, high) in limits.items():
+        if name in out:
+            out[name] = min(
+                max(out[name], math.radians(low) + HEAD_LIMIT_MARGIN_RAD),
+                math.radians(high) - HEAD_LIMIT_MARGIN_RAD,
+            )
+    return out
+
+
 def head_angles_towards(kinematics: RobotKinematics, joints: dict[str, float], target: np.ndarray) -> dict:
     """Pan and tilt that point the head at `target` (base_footprint), from the head joint origins."""
     level = {**joints, "head_1_joint": 0.0, "head_2_joint": 0.0}

@@ -27,7 +27,7 @@ from lab_description.station_placement import nest_working_pose
 from lab_description.world import Station
 from robot_port.execution import Execution
 from tiago_description import transforms as tf
-from tiago_description.kinematics import RobotKinematics, head_angles_towards
+from tiago_description.kinematics import RobotKinematics, head_angles_towards, within_head_limits
 from tiago_skills.behaviours import move_joints
 from tiago_skills.goal_run import ActionAbort, GoalRun
 
@@ -62,7 +62,7 @@ def _search(run: GoalRun, kinematics: RobotKinematics, target: np.ndarray, look:
                 run.follow(lifting, span=(0.0, 0.15))
         joints = run.read(lambda hardware: dict(hardware.joint_positions()))
         head = head_angles_towards(kinematics, joints, target)
-        aim = {**head, "head_1_joint": head["head_1_joint"] + pan_offset}
+        aim = within_head_limits({**head, "head_1_joint": head["head_1_joint"] + pan_offset})
         run.follow(move_joints(aim), span=(0.0, 0.15))
         try:
             return look(run)
