@@ -15,6 +15,7 @@ import yaml
 from lab_description.serviceability import (
     ALIGN_DRIVE_OVERSHOOT,
     ALIGN_SIGHTING_ERROR,
+    MARKER_MAX_OBLIQUITY_DEG,
     WORKING_CLEARANCE,
     bench_distance,
 )
@@ -112,14 +113,14 @@ def test_stations_too_close_for_the_hotel_tray_to_turn_are_refused(tmp_path: Pat
 
 
 def test_a_marker_the_head_camera_cannot_see_from_the_poi_is_refused(tmp_path: Path) -> None:
-    def lying_flat(data: dict[str, Any]) -> None:  # a marker lying on the bench, face up
-        data["stations"][0]["marker"]["rpy"] = [0, 0, -90]
-        data["stations"][0]["nests"]["site_in_marker_rpy"] = [0, 0, 0]
-        data["stations"][0]["nests"]["site_in_marker_xyz"] = [-0.085, -0.13, -0.09]
+    def tilted_away(data: dict[str, Any]) -> None:  # a marker lying on the bench, face up, tilted 20 deg away
+        data["stations"][0]["marker"]["rpy"] = [-20, 0, -90]
+        data["stations"][0]["nests"]["site_in_marker_rpy"] = [20, 0, 0]  # the nests where they were
+        data["stations"][0]["nests"]["site_in_marker_xyz"] = [-0.085, -0.0914, -0.129]
 
-    problems = refusal(tmp_path, lying_flat)
+    problems = refusal(tmp_path, tilted_away)
     view = [line for line in problems if "cannot see marker 3 from POI station_a_work" in line]
-    assert view and "off its face's normal (at most 60)" in view[0], problems
+    assert view and f"off its face's normal (at most {MARKER_MAX_OBLIQUITY_DEG:g})" in view[0], problems
     assert not any("reach" in line for line in problems)
 
 
