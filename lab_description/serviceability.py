@@ -70,11 +70,12 @@ LOOK_TORSO_LIFT = 0.15
 CAMERA_FOCAL_PX = 522.2
 MARKER_DISTANCE_RANGE = (0.4, 1.6)
 """Camera to marker centre (m): the camera clips at 0.3 m; beyond 1.5 to 2.5 m detection failed."""
-MARKER_MAX_OBLIQUITY_DEG = 65.0
+MARKER_MAX_OBLIQUITY_DEG = 60.0
 """Angle between the marker's normal and the line to the camera. The skills' detector, on the simulator's
-rendering with camera noise, found the marker in every view up to 75 deg; the heading error's 95th
-percentile is 0.4 to 0.6 deg up to 65 deg and doubles at 70 (`python -m
-tiago_sim.measuring.marker_obliquity`; the benchmarks page has the table)."""
+rendering with camera noise, found the marker in every view up to 75 deg, with the heading error's
+95th percentile 0.4 to 0.6 deg up to 65 deg (`python -m tiago_sim.measuring.marker_obliquity`); but
+65 deg let in stations whose working pose then lay nearer and whose transfers failed in a campaign
+(the benchmarks page), so the rule stays at 60 deg until those are understood."""
 MARKER_MIN_PIXELS = 40.0
 """Side of the black square in the 640 x 480 image; the pose error grows fast below this."""
 CEILING_MARGIN = 0.02
