@@ -73,7 +73,7 @@ MARKER_DISTANCE_RANGE = (0.4, 1.6)
 MARKER_MAX_OBLIQUITY_DEG = 60.0
 """Angle between the marker's normal and the line to the camera. The skills' detector, on the simulator's
 rendering with camera noise, found the marker in every view up to 75 deg, with the heading error's
-95th percentile 0.4 to 0.6 deg up to 65 deg (`python -m tiago_sim.measuring.marker_obliquity`); but
+95th percentile 0.4 to 0.6 deg up to 65 deg (`python -m tiago_twin.marker_obliquity`); but
 65 deg let in stations whose working pose then lay nearer and whose transfers failed in a campaign
 (the benchmarks page), so the rule stays at 60 deg until those are understood."""
 MARKER_MIN_PIXELS = 40.0

@@ -7,9 +7,10 @@ Why: the loader refuses a station whose marker the head camera sees more than
 rendering with the default camera noise (colour read noise 2 grey levels, depth noise 1.9 mm at
 1 m), over the distances and marker sizes drawn lab furniture has, and prints per obliquity bin the
 detection rate and the position and heading errors that matter for a nest up to 0.5 m from its
-marker. Ground truth is only the expectation here.
+marker. Ground truth is only the expectation here. It lives with the start-up because it joins the
+skills' detector to the simulator's camera, as the twin does.
 
-    python -m tiago_sim.measuring.marker_obliquity [--views 40] [--seed 1]
+    python -m tiago_twin.marker_obliquity [--views 40] [--seed 1]
 """
 
 from __future__ import annotations
