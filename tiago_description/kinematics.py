@@ -82,6 +82,18 @@ class RobotKinematics:
         """Index in q (and v) of a one-dof joint."""
         return self.model.joints[self.model.getJointId(name)].idx_q
 
+    @staticmethod
+    def ik_joint_names(arm: str, use_torso: bool) -> list[str]:
+        """The joints IK moves for `arm`: its seven, with the torso lift first when asked."""
+        names = robot_model.arm_joint_names(arm)
+        return ["torso_lift_joint", *names] if use_torso else list(names)
+
+    def joint_limits(self, names: list[str]) -> list[tuple[float, float]]:
+        """(lower, upper) of each named one-dof joint."""
+        return [
+            (float(self.lower[self.joint_index(n)]), float(self.upper[self.joint_index(n)])) for n in names
+        ]
+
     def inverse(
         self,
         arm: str,
@@ -98,9 +110,7 @@ class RobotKinematics:
         Damped least squares (damping 1e-3) with joint-limit clamping; the first attempt starts
         from ``seed_positions`` (so the nearest solution wins), then seeded random restarts.
         """
-        names = robot_model.arm_joint_names(arm)
-        if use_torso:
-            names = ["torso_lift_joint", *names]
+        names = self.ik_joint_names(arm, use_torso)
         indices = np.array([self.joint_index(name) for name in names])
         frame_id = self.model.getFrameId(f"gripper_{arm}_grasping_frame")
         target = pin.SE3(np.asarray(T_base_target, dtype=float))
@@ -149,10 +159,8 @@ class RobotKinematics:
         DISTINCT_SOLUTION_RAD on every joint), least joint travel from ``seed_positions`` first: the
         seeded solve, then solves from `tries` random starts. Why: one joint-space move to the nearest
         solution may sweep through something another solution passes clear of."""
-        names = robot_model.arm_joint_names(arm)
-        if use_torso:
-            names = ["torso_lift_joint", *names]
-        limits = [(self.lower[self.joint_index(n)], self.upper[self.joint_index(n)]) for n in names]
+        names = self.ik_joint_names(arm, use_torso)
+        limits = self.joint_limits(names)
         rng = np.random.default_rng(seed)
         found: list[dict[str, float]] = []
         for attempt in range(tries + 1):

@@ -105,12 +105,7 @@ class ArmPlanning:
         with self._lock:
             scene = self._clearance.scene(arm, boxes, held, body=True)
             kinematics = self._kinematics
-            limits = np.array(
-                [
-                    (kinematics.lower[kinematics.joint_index(n)], kinematics.upper[kinematics.joint_index(n)])
-                    for n in names
-                ]
-            )
+            limits = np.array(kinematics.joint_limits(names))
             least = min(clearance_m, scene.nearest(kinematics.configuration(start)).distance_m - 0.002)
 
             def is_free(x: np.ndarray) -> bool:
