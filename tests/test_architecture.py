@@ -41,7 +41,9 @@ ALLOWED: dict[str, set[str]] = {
     # the robot's software: sees the robot only through the port, never the simulator
     "tiago_skills.perception": {"robot_port", "tiago_description"},
     "tiago_skills": {"labware_model", "robot_port", *DESCRIPTIONS, "tiago_skills.perception"},
-    "tiago_sim.node_main": set(),
+    # the starter's pid, read first by a robot-side process (node_main stops when it is gone)
+    "tiago_sim.started_by": set(),
+    "tiago_sim.node_main": {"tiago_sim.started_by"},
     "tiago_sim.navigation": {"labware_model", *DESCRIPTIONS},
     # `world check`: the loader's rules, the planner's paths between POIs, the picture
     "tiago_sim.inspection": {"labware_model", *DESCRIPTIONS, "tiago_sim.navigation"},
@@ -66,7 +68,12 @@ ALLOWED: dict[str, set[str]] = {
         "tiago_sim.navigation",
     },
     # the task level: a ROS client of the robot's actions, as on the real robot
-    "tiago_sim.sequencer": {"labware_model", "tiago_sim.node_main", "lab_description"},
+    "tiago_sim.sequencer": {
+        "labware_model",
+        "tiago_sim.node_main",
+        "tiago_sim.started_by",
+        "lab_description",
+    },
     # the start-up: the one unit that imports both the simulator and the skills
     "tiago_twin": {
         "robot_port",
@@ -74,6 +81,7 @@ ALLOWED: dict[str, set[str]] = {
         "tiago_skills",
         "tiago_skills.perception",
         "tiago_sim.node_main",
+        "tiago_sim.started_by",
         "tiago_sim.sim_node",
         "tiago_sim.physics",
         "tiago_sim.measuring",

@@ -21,6 +21,8 @@ from rclpy.executors import Executor, ExternalShutdownException
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
+from tiago_sim.started_by import starter_pid
+
 log = logging.getLogger(__name__)
 
 
@@ -49,7 +51,7 @@ def spin_node(
 
     signal.signal(signal.SIGINT, request_stop)
     signal.signal(signal.SIGTERM, request_stop)
-    parent = os.getppid()
+    parent = starter_pid()
     owner = None
     try:
         owner = build(node)
