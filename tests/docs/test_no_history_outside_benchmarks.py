@@ -2,7 +2,8 @@
 
 Elsewhere the documentation says what holds and why; which trial revealed a rule, and at which
 commit, is history. A commit id here is 7 to 40 hex digits with at least one digit and one of a-f
-(so neither a plain number nor a word); a campaign seed is a number of three or more digits after
+(so neither a plain number nor a word), except an upstream source cited as `owner/repository@commit`;
+a campaign seed is a number of three or more digits after
 "seed", "trial", "--replay" or "--save-layout", or any bare number of five or six digits other than
 the ports the pages use as examples.
 """
@@ -16,7 +17,7 @@ import pytest
 
 from tests.docs.pages import DOCS, name, pages
 
-COMMIT = re.compile(r"(?<![\w/#.-])(?=[0-9a-f]*[0-9])(?=[0-9a-f]*[a-f])[0-9a-f]{7,40}(?![\w/-])")
+COMMIT = re.compile(r"(?<![\w/#.@-])(?=[0-9a-f]*[0-9])(?=[0-9a-f]*[a-f])[0-9a-f]{7,40}(?![\w/-])")
 SEED_AFTER_WORD = re.compile(r"(?i)\b(?:seeds?|trials?|--replay|--save-layout|layouts?)\s+(\d{3,})\b")
 BARE_NUMBER = re.compile(r"(?<![\w.,:/-])(\d{5,6})(?!\w|[.,]\d)")
 EXAMPLE_PORTS = {"50052", "50053", "50054", "57000"}
@@ -47,5 +48,6 @@ def test_the_rule_finds_what_it_is_meant_to_find() -> None:
     assert history_in("at `a1b2b8b`, 200/200") == ["commit id a1b2b8b"]
     assert history_in("random layout 91028 put a pad") and history_in("seed 2041 stopped")
     assert history_in("`bench --replay 10145`")
+    assert not history_in("`ros2/geometry2@f3b6a866d8d2d3b48dd735144849842e4ae81b7d`")
     assert not history_in("port 50052, 127.0.0.1, 0.265 m, 1,071 results, decade, 2 cores, seed 1")
     assert not history_in("server_uuid 6c1e, colour #4a9b3cd, sub-position 12")
