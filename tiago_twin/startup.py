@@ -1,7 +1,7 @@
 """Start the digital twin: the simulated TIAGo++ and the robot's skills on one ROS 2 node.
 
     python -m tiago_twin --world FILE [--seed N] [--realtime-factor-cap X]
-        [--idle-realtime-factor X] [--disturbance-seed N] ...
+        [--idle-realtime-factor X] [--disturbance-seed N] [--robot-interfaces] ...
 
 Why one module: it is the one place that knows both sides. The simulator (tiago_sim.sim_node)
 plays the hardware and the vendor's stack and offers the hardware port; the skills
@@ -27,6 +27,7 @@ from lab_description.world import DEFAULT_WORLD, World, WorldError, load_world
 from tiago_description.motion_library import DEFAULT_MOTIONS_FILE
 from tiago_sim.measuring.run_recorder import RunRecorder
 from tiago_sim.node_main import spin_node
+from tiago_sim.sim_node.controllers import TrajectoryControllers
 from tiago_sim.sim_node.hardware import SimulatedHardware
 from tiago_sim.sim_node.navigation import Navigation
 from tiago_sim.sim_node.node import SimNode, make_simulation, robot_world
@@ -76,6 +77,12 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     )
     parser.add_argument("--disturbance-levels", default="", help="DisturbanceLevels JSON")
     parser.add_argument("--record-dir", type=Path, default=None, help="save camera frames here")
+    parser.add_argument(
+        "--robot-interfaces",
+        action="store_true",
+        help="also serve a TIAGo++'s own ROS 2 interfaces (its controllers' FollowJointTrajectory "
+        "actions), for software written against a real robot",
+    )
     parser.add_argument("--log-level", default="INFO")
     parser.add_argument(
         "--near-misses",
@@ -134,6 +141,8 @@ def main(argv: list[str] | None = None) -> int:
             activity_signature=skills.actions.activity.signature,
         )
         built.append(sim_node)
+        if args.robot_interfaces:  # kept with the node: its action servers live as long
+            sim_node.robot_controllers = TrajectoryControllers(node, sim_thread)
         lab_reset = LabReset(node, sim_thread, skills.actions.slot)
         lab_reset.hooks += [sim_node.forget_the_old_lab, skills.forget]
         log.info("sim node ready: world %s, %d stations", world.source, len(world.stations))

@@ -23,7 +23,7 @@ from robot_port.types import CameraIntrinsics, JointTrajectory, joint_group
 from tiago_description import robot_model as rm
 from tiago_sim.navigation.blockage import UnmappedObstacles
 from tiago_sim.navigation.planner import Plan
-from tiago_sim.physics.arm_controller import JointTrajectoryMotion
+from tiago_sim.physics.arm_controller import JointTrajectoryMotion, TimedTrajectoryMotion
 from tiago_sim.physics.base_controller import DiffDriveBase, DriveMotion, VelocityMotion, docking_motion
 from tiago_sim.physics.base_laser import BaseLaser, LaserSpec, laser_rng
 from tiago_sim.physics.camera import render_rgbd
@@ -362,6 +362,30 @@ class Simulation:
             name=trajectory.name,
             min_segment_s=trajectory.min_segment_s,
             resources=frozenset(self._joint_resource(n) for n in names),
+        )
+        return self._start(motion)
+
+    def follow_timed_trajectory(
+        self,
+        names: list[str],
+        times_s: list[float],
+        positions: list[list[float]],
+        velocities: list[list[float]] | None,
+        name: str = "follow_joint_trajectory",
+    ) -> Motion:
+        """A joint trajectory controller's goal: points with their times (a FollowJointTrajectory goal,
+        checked by the caller). The fingers of a gripper close, or open, as a gripper command does
+        (stopping on what they meet), by whether the last point closes them past half their travel."""
+        unknown = [n for n in names if n not in self.robot.joint_index]
+        if unknown or not names:
+            return FailedMotion(name, "BAD_GOAL", f"unknown joints {unknown}" if unknown else "no joints")
+        groups = {self._joint_resource(n) for n in names}
+        if len(groups) == 1 and next(iter(groups)).startswith("gripper_"):
+            side = next(iter(groups)).removeprefix("gripper_")
+            closing = sum(positions[-1]) / len(names) < rm.FINGER_TRAVEL / 2
+            return self.gripper(side, closing)
+        motion = TimedTrajectoryMotion(
+            self.robot, names, times_s, positions, velocities, name=name, resources=frozenset(groups)
         )
         return self._start(motion)
 

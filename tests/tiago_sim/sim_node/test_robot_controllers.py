@@ -1,0 +1,162 @@
+"""The simulator's joint trajectory controllers, spoken to as a TIAGo++'s are (tiago_twin --robot-interfaces).
+
+A real rclpy client sends control_msgs/FollowJointTrajectory goals over DDS to the twin in its own
+process; the joints move in PyBullet and are read back from /joint_states. The controllers behave
+as ros2_controllers' JointTrajectoryController does: invalid goals are rejected, a new goal
+preempts the running one, a cancel stops the joints where they are.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import pytest
+from action_msgs.msg import GoalStatus
+from builtin_interfaces.msg import Duration
+from control_msgs.action import FollowJointTrajectory
+from rclpy.action import get_action_names_and_types
+from sensor_msgs.msg import JointState
+from trajectory_msgs.msg import JointTrajectoryPoint
+
+from lab_description.world import DEFAULT_WORLD
+from robot_port.types import JOINT_GROUPS
+from tests.helpers.ros_processes import RosCaller, running
+from tiago_sim.sim_node.controllers import controller_action, controller_joints
+
+HEAD = controller_action("head")
+TORSO = controller_action("torso")
+
+
+@pytest.fixture(scope="module")
+def robot(tmp_path_factory: pytest.TempPathFactory) -> Iterator[RosCaller]:
+    log_path = tmp_path_factory.mktemp("ros_logs") / "twin.log"
+    # at most 5 times real time: a 30 s goal lasts seconds of wall time, for a preempt or a cancel
+    arguments = ["--world", str(DEFAULT_WORLD), "--seed", "3", "--robot-interfaces"]
+    with running("tiago_twin", *arguments, "--realtime-factor-cap", "5", log_path=log_path):
+        caller = RosCaller("test_robot_controllers")
+        caller.subscribe(JointState, "/joint_states")
+        try:
+            caller.wait_for(lambda: "/joint_states" in caller.latest, 120.0, "the twin's /joint_states")
+            yield caller
+        finally:
+            caller.close()
+
+
+def joints_now(caller: RosCaller) -> dict[str, float]:
+    """A /joint_states message that arrived after this call (so it shows what stands now)."""
+    caller.latest.pop("/joint_states", None)
+    caller.wait_for(lambda: "/joint_states" in caller.latest, 30.0, "a fresh /joint_states")
+    message = caller.latest["/joint_states"]
+    return dict(zip(message.name, message.position, strict=True))
+
+
+def goal(
+    names: list[str], *points: tuple[float, list[float], list[float] | None]
+) -> FollowJointTrajectory.Goal:
+    request = FollowJointTrajectory.Goal()
+    request.trajectory.joint_names = names
+    for at, positions, velocities in points:
+        point = JointTrajectoryPoint(positions=positions, velocities=velocities or [])
+        point.time_from_start = Duration(sec=int(at), nanosec=int(round((at % 1) * 1e9)))
+        request.trajectory.points.append(point)
+    return request
+
+
+def test_every_controller_is_served_under_pals_name(robot: RosCaller) -> None:
+    wanted = {
+        controller_action(group): ["control_msgs/action/FollowJointTrajectory"] for group in JOINT_GROUPS
+    }
+
+    def served() -> bool:
+        names = dict(get_action_names_and_types(robot.node))
+        return all(names.get(name) == kind for name, kind in wanted.items())
+
+    robot.wait_for(served, 30.0, "every controller's action")
+
+
+def test_a_head_goal_moves_the_head_and_reports_its_progress(robot: RosCaller) -> None:
+    names = controller_joints("head")
+    start = joints_now(robot)
+    target = [start[names[0]] + 0.3, start[names[1]] - 0.2]
+    outcome = robot.call_action(FollowJointTrajectory, HEAD, goal(names, (1.5, target, None)), 60.0)
+    assert outcome.status == GoalStatus.STATUS_SUCCEEDED
+    assert outcome.result.error_code == FollowJointTrajectory.Result.SUCCESSFUL
+    now = joints_now(robot)
+    assert [now[name] for name in names] == pytest.approx(target, abs=0.02)
+    assert outcome.feedback, "no feedback while the head moved"
+    assert list(outcome.feedback[-1].joint_names) == names
+
+
+def test_points_with_velocities_pass_through_each_point(robot: RosCaller) -> None:
+    start = joints_now(robot)["torso_lift_joint"]
+    up = min(start + 0.06, 0.34)
+    points = ((1.0, [(start + up) / 2], [0.05]), (2.0, [up], [0.0]))
+    outcome = robot.call_action(FollowJointTrajectory, TORSO, goal(["torso_lift_joint"], *points), 60.0)
+    assert outcome.result.error_code == FollowJointTrajectory.Result.SUCCESSFUL
+    assert joints_now(robot)["torso_lift_joint"] == pytest.approx(up, abs=0.01)
+
+
+@pytest.mark.parametrize(
+    "names, points, why",
+    [
+        (["head_1_joint", "torso_lift_joint"], ((1.0, [0.0, 0.1], None),), "a joint of another controller"),
+        (["head_1_joint"], ((1.0, [0.0], None),), "a joint of the controller missing"),
+        (["head_1_joint", "head_2_joint"], ((1.0, [0.0], None),), "a point short of a position"),
+        (
+            ["head_1_joint", "head_2_joint"],
+            ((1.0, [0.0, 0.0], None), (0.5, [0.1, 0.0], None)),
+            "time going back",
+        ),
+    ],
+)
+def test_an_invalid_goal_is_rejected(robot: RosCaller, names: list[str], points: tuple, why: str) -> None:
+    handle = robot.send(FollowJointTrajectory, HEAD, goal(names, *points))
+    assert not handle.accepted, why
+
+
+def test_a_new_goal_preempts_the_running_one(robot: RosCaller) -> None:
+    names = controller_joints("head")
+    start = joints_now(robot)
+    away = [start[names[0]] - 0.5, start[names[1]]]
+    slow = robot.send(FollowJointTrajectory, HEAD, goal(names, (30.0, away, None)))
+    assert slow.accepted
+    robot.wait_for(lambda: slow.outcome.feedback, 30.0, "the first goal's start")
+    target = [start[names[0]], start[names[1]] + 0.1]
+    fast = robot.send(FollowJointTrajectory, HEAD, goal(names, (1.0, target, None)))
+    assert fast.accepted
+    first, second = robot.result(slow, 60.0), robot.result(fast, 60.0)
+    assert first.status == GoalStatus.STATUS_ABORTED and "preempted" in first.result.error_string
+    assert second.status == GoalStatus.STATUS_SUCCEEDED
+    now = joints_now(robot)
+    assert [now[name] for name in names] == pytest.approx(target, abs=0.02)
+
+
+def test_a_cancelled_goal_stops_the_joints_where_they_are(robot: RosCaller) -> None:
+    names = controller_joints("head")
+    start = joints_now(robot)
+    away = [start[names[0]] + 0.6, start[names[1]]]
+    handle = robot.send(FollowJointTrajectory, HEAD, goal(names, (30.0, away, None)))
+    robot.wait_for(lambda: handle.outcome.feedback, 30.0, "the goal's start")
+    robot.spin_for(1.0)
+    robot.spin_until(handle.cancel_goal_async(), 30.0)
+    outcome = robot.result(handle, 60.0)
+    assert outcome.status == GoalStatus.STATUS_CANCELED
+    stopped = joints_now(robot)
+    robot.spin_for(1.0)
+    later = joints_now(robot)
+    moved_on = later[names[0]] - stopped[names[0]]
+    assert moved_on == pytest.approx(0.0, abs=0.005), "the head moved on after the cancel"
+    assert start[names[0]] < stopped[names[0]] < start[names[0]] + 0.6, (
+        "the head did not move, or went all the way"
+    )
+
+
+def test_a_gripper_goal_closes_and_opens_the_fingers(robot: RosCaller) -> None:
+    names = controller_joints("gripper_left")
+    action = controller_action("gripper_left")
+    closed = robot.call_action(FollowJointTrajectory, action, goal(names, (1.0, [0.0, 0.0], None)), 60.0)
+    assert closed.result.error_code == FollowJointTrajectory.Result.SUCCESSFUL
+    assert max(joints_now(robot)[name] for name in names) < 0.003
+    opened = robot.call_action(FollowJointTrajectory, action, goal(names, (1.0, [0.044, 0.044], None)), 60.0)
+    assert opened.result.error_code == FollowJointTrajectory.Result.SUCCESSFUL
+    assert min(joints_now(robot)[name] for name in names) > 0.04
