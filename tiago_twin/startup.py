@@ -27,10 +27,10 @@ from lab_description.world import DEFAULT_WORLD, World, WorldError, load_world
 from tiago_description.motion_library import DEFAULT_MOTIONS_FILE
 from tiago_sim.measuring.run_recorder import RunRecorder
 from tiago_sim.node_main import spin_node
-from tiago_sim.sim_node.controllers import TrajectoryControllers
 from tiago_sim.sim_node.hardware import SimulatedHardware
 from tiago_sim.sim_node.navigation import Navigation
 from tiago_sim.sim_node.node import SimNode, make_simulation, robot_world
+from tiago_sim.sim_node.robot_interfaces import RobotInterfaces
 from tiago_sim.sim_node.sim_thread import SimThread
 from tiago_skills.perception.aruco import detect_marker, draw_detection
 from tiago_skills.skills_node import RobotSkills
@@ -80,8 +80,8 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser.add_argument(
         "--robot-interfaces",
         action="store_true",
-        help="also serve a TIAGo++'s own ROS 2 interfaces (its controllers' FollowJointTrajectory "
-        "actions), for software written against a real robot",
+        help="also serve a TIAGo++'s own ROS 2 interfaces (the controllers' FollowJointTrajectory, "
+        "the base's velocity command, Nav2's navigate_to_pose), for software written against a robot",
     )
     parser.add_argument("--log-level", default="INFO")
     parser.add_argument(
@@ -142,7 +142,7 @@ def main(argv: list[str] | None = None) -> int:
         )
         built.append(sim_node)
         if args.robot_interfaces:  # kept with the node: its action servers live as long
-            sim_node.robot_controllers = TrajectoryControllers(node, sim_thread)
+            sim_node.robot_interfaces = RobotInterfaces(node, sim_thread, navigation)
         lab_reset = LabReset(node, sim_thread, skills.actions.slot)
         lab_reset.hooks += [sim_node.forget_the_old_lab, skills.forget]
         log.info("sim node ready: world %s, %d stations", world.source, len(world.stations))

@@ -1,9 +1,9 @@
 """How far the robot's believed pose and its raw odometry are from the simulator's truth, over ROS.
 
 Why from topics: the long runs talk to a `serve` in another process; the sim node publishes the
-believed pose (/robot_state base_pose, the localised estimate), raw odometry (/odom) and, like
-Gazebo's ground-truth plugins, the true pose (/ground_truth/base_pose), all from one snapshot.
-The truth is read here only to measure.
+believed pose (/robot_state base_pose, the localised estimate), raw odometry
+(/mobile_base_controller/odom) and, like Gazebo's ground-truth plugins, the true pose
+(/ground_truth/base_pose), all from one snapshot. The truth is read here only to measure.
 """
 
 from __future__ import annotations
@@ -56,7 +56,7 @@ class PoseErrorProbe:
                     lambda m: keep("believed", (m.base_pose.x, m.base_pose.y, m.base_pose.theta)),
                     qos,
                 ),
-                node.create_subscription(Odometry, "/odom", odometry, qos),
+                node.create_subscription(Odometry, "/mobile_base_controller/odom", odometry, qos),
             ]
 
         self.subscriptions = runtime.call(subscribe)

@@ -343,6 +343,15 @@ class VelocityMotion(Motion):
         self.phase = "driving"
         self.remaining_s = self.duration_s
 
+    def renew(self, linear: float, angular: float, duration_s: float) -> bool:
+        """A new command before this one ran out: the new twist, for `duration_s` from now, without
+        braking between (a velocity topic's next message). False once braking has begun."""
+        if self.done or self.cancel_requested or self.elapsed_s >= self.duration_s:
+            return False
+        self.linear, self.angular = linear, angular
+        self.duration_s = self.elapsed_s + max(duration_s, 0.0)
+        return True
+
     def tick(self, dt: float) -> None:
         braking = self.cancel_requested or self.elapsed_s >= self.duration_s
         if braking:

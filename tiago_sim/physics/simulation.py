@@ -366,28 +366,15 @@ class Simulation:
         return self._start(motion)
 
     def follow_timed_trajectory(
-        self,
-        names: list[str],
-        times_s: list[float],
-        positions: list[list[float]],
-        velocities: list[list[float]] | None,
-        name: str = "follow_joint_trajectory",
+        self, names: list[str], times_s: list[float], positions: list, velocities: list | None, name: str
     ) -> Motion:
-        """A joint trajectory controller's goal: points with their times (a FollowJointTrajectory goal,
-        checked by the caller). The fingers of a gripper close, or open, as a gripper command does
-        (stopping on what they meet), by whether the last point closes them past half their travel."""
-        unknown = [n for n in names if n not in self.robot.joint_index]
-        if unknown or not names:
-            return FailedMotion(name, "BAD_GOAL", f"unknown joints {unknown}" if unknown else "no joints")
-        groups = {self._joint_resource(n) for n in names}
-        if len(groups) == 1 and next(iter(groups)).startswith("gripper_"):
-            side = next(iter(groups)).removeprefix("gripper_")
-            closing = sum(positions[-1]) / len(names) < rm.FINGER_TRAVEL / 2
-            return self.gripper(side, closing)
-        motion = TimedTrajectoryMotion(
-            self.robot, names, times_s, positions, velocities, name=name, resources=frozenset(groups)
+        """A joint trajectory controller's goal: points with their times (checked by the caller)."""
+        if any(n not in self.robot.joint_index for n in names) or not names:
+            return FailedMotion(name, "BAD_GOAL", f"unknown joints among {names}")
+        groups = frozenset(self._joint_resource(n) for n in names)
+        return self._start(
+            TimedTrajectoryMotion(self.robot, names, times_s, positions, velocities, name, groups)
         )
-        return self._start(motion)
 
     @staticmethod
     def _joint_resource(name: str) -> str:

@@ -5,7 +5,8 @@ action per controller (`/arm_left_controller/follow_joint_trajectory`, ...; PAL'
 docs/reference/robot-interfaces.md). The simulator offers the same actions, so that software
 written against a robot's interfaces runs against the twin unchanged. Each goal runs on the sim
 thread as a `TimedTrajectoryMotion` (the points at their times) or, for a gripper, as a gripper
-command that stops on what the fingers meet.
+command that stops on what the fingers meet: closing when the last point closes the fingers past
+half their travel, else opening.
 
 As ros2_controllers' JointTrajectoryController does: a goal whose trajectory is not valid for the
 controller (joints it does not have, a joint of it missing, points without a position per joint,
@@ -30,6 +31,7 @@ from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 from trajectory_msgs.msg import JointTrajectoryPoint
 
+from robot_port.tiago_interfaces import controller_action
 from robot_port.types import JOINT_GROUPS
 from tiago_description import robot_model as rm
 from tiago_sim.sim_node.localisation_topics import stamp_of
@@ -41,11 +43,6 @@ FEEDBACK_PERIOD_S = 0.2
 """Wall seconds between a goal's feedback messages (a controller sends one per update; at 20 times
 real time that would be thousands a second)."""
 MOTION_ANSWER_TIMEOUT_S = 60.0
-
-
-def controller_action(group: str) -> str:
-    """The FollowJointTrajectory action of a joint group's controller (PAL's name)."""
-    return f"/{group}_controller/follow_joint_trajectory"
 
 
 def controller_joints(group: str) -> list[str]:
@@ -140,9 +137,13 @@ class TrajectoryControllers:
         velocities = [list(point.velocities) for point in trajectory.points]
         timed = velocities if all(velocities) else None
         label = f"{group}_controller"
-        motion = self._start(
-            group, handle, lambda sim: sim.follow_timed_trajectory(names, times, positions, timed, name=label)
-        )
+        if group.startswith("gripper_"):  # the fingers close or open as a gripper command moves them
+            closing = sum(positions[-1]) / len(names) < rm.FINGER_TRAVEL / 2
+            side = group.removeprefix("gripper_")
+            motion = self._start(group, handle, lambda sim: sim.gripper(side, closing))
+        else:
+            job = lambda sim: sim.follow_timed_trajectory(names, times, positions, timed, label)  # noqa: E731
+            motion = self._start(group, handle, job)
         result = FollowJointTrajectory.Result()
         self._feedback(handle, names, motion)  # one at the start: a short goal may end before the next
         while not motion.finished.wait(FEEDBACK_PERIOD_S):

@@ -23,10 +23,11 @@ from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import LaserScan
 
+from robot_port.tiago_interfaces import LASER
 from tiago_sim.physics.base_laser import LASER_FRAME, LaserReading
 from tiago_sim.sim_node.localisation import Localised
 
-SCAN_TOPIC = "/scan"
+SCAN_TOPIC = LASER
 POSE_TOPIC = "/amcl_pose"
 CORRECTION_TOPIC = "/map_to_odom"
 MAP_FRAME = "map"

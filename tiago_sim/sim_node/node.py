@@ -64,7 +64,7 @@ class SimNode:
         self.occluders = Occluders(world)
         self.plate_faults = PlateFaults()
         self.navigation = navigation
-        self.robot_controllers: Any = None  # a robot's own controller actions, when the start-up serves them
+        self.robot_interfaces: Any = None  # a robot's own ROS interfaces, when the start-up serves them
         self.path_blocker = self._path_blocker()
         self._declare_parameters()
         # the robot's localisation: laser scans against the map of the world the robot believes

@@ -1,5 +1,6 @@
-"""Topics of the sim node: /clock, /odom, /joint_states, /robot_state, /station_states, camera,
-and localisation's (/scan, /amcl_pose, /map_to_odom: localisation_topics).
+"""Topics of the sim node: /clock, /mobile_base_controller/odom, /joint_states, /robot_state,
+/station_states, the head camera's (camera_topics) and localisation's (/scan_raw, /amcl_pose,
+/map_to_odom: localisation_topics).
 
 A wall-clock timer (executor thread) takes one snapshot of the robot's own sensors from the sim
 thread and publishes it; nothing here touches PyBullet directly. /robot_state goes out when it
@@ -25,19 +26,18 @@ from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
-from sensor_msgs.msg import CameraInfo, Image, JointState
+from sensor_msgs.msg import JointState
 
 from labware_model.readings import HotelSlotReading, NestReading
+from robot_port.tiago_interfaces import ODOMETRY
 from tiago_description.transforms import wrap_angle
+from tiago_sim.sim_node.camera_topics import CameraTopics
 from tiago_sim.sim_node.localisation import LocalisationLoop
 from tiago_sim.sim_node.localisation_topics import LocalisationTopics, LocalisationView, stamp_of
 from tiago_sim.sim_node.sim_thread import SimThread
 
 log = logging.getLogger(__name__)
 
-CAMERA_IMAGE_TOPIC = "/head_front_camera/rgb/image_raw"
-CAMERA_INFO_TOPIC = "/head_front_camera/rgb/camera_info"
-CAMERA_FRAME = "head_front_camera_rgb_optical_frame"
 # The robot state and station states go out at least this often (s), news or not: a reader's
 # clock (SimulatedLabController.SimulatedTime reads the last /robot_state's stamp) is never staler.
 SLOW_PERIOD_S = 0.5
@@ -135,7 +135,6 @@ class StatePublishers:
         activity_signature: Callable[[], tuple] | None = None,
         rate_hz: float = 20.0,
         idle_rate_hz: float = 5.0,
-        camera_rate_hz: float = 2.0,
     ) -> None:
         self.node = node
         self.sim_thread = sim_thread
@@ -159,22 +158,19 @@ class StatePublishers:
         self.poi_yaw_tolerance_rad = 0.15
         reliable = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
         self.clock_pub = node.create_publisher(Clock, "/clock", reliable)
-        self.odom_pub = node.create_publisher(Odometry, "/odom", reliable)
+        self.odom_pub = node.create_publisher(Odometry, ODOMETRY, reliable)
         self.joint_pub = node.create_publisher(JointState, "/joint_states", reliable)
         self.robot_state_pub = node.create_publisher(RobotState, "/robot_state", reliable)
         self.station_pub = node.create_publisher(StationStates, "/station_states", reliable)
         # Simulator truth, like Gazebo's ground-truth plugins: for benchmarks, never for the robot.
         self.truth_pub = node.create_publisher(Pose2D, "/ground_truth/base_pose", reliable)
-        self.image_pub = node.create_publisher(Image, CAMERA_IMAGE_TOPIC, 2)
-        self.info_pub = node.create_publisher(CameraInfo, CAMERA_INFO_TOPIC, 2)
+        self.camera = CameraTopics(node, sim_thread)
         self._last_robot_key: tuple | None = None
         self._last_nests: tuple | None = None
         self._last_slow_publish = 0.0
         self._pending: Any = None
-        self._camera_pending: Any = None
         self._previous_odometry: tuple[float, tuple[float, float, float]] | None = None
         node.create_timer(1.0 / rate_hz, self._tick)
-        node.create_timer(1.0 / camera_rate_hz, self._camera_tick)
 
     # -- sensors -> topics ---------------------------------------------------------------
     def _tick(self) -> None:
@@ -335,41 +331,3 @@ class StatePublishers:
                 for reading in snapshot.nests
             ]
         )
-
-    # -- head camera -------------------------------------------------------------------
-    def _camera_tick(self) -> None:
-        if self.image_pub.get_subscription_count() == 0 and self.info_pub.get_subscription_count() == 0:
-            return
-        if self._camera_pending is not None and not self._camera_pending.done():
-            return
-        if self._camera_pending is not None and self._camera_pending.exception() is None:
-            self._publish_camera(*self._camera_pending.result())
-        self._camera_pending = self.sim_thread.call(
-            lambda sim: (float(sim.sim_time), *sim.render_head_camera())
-        )
-
-    def _publish_camera(self, sim_time: float, rgb: Any, _depth: Any, intrinsics: Any) -> None:
-        stamp = stamp_of(sim_time)
-        image = Image()
-        image.header.stamp = stamp
-        image.header.frame_id = CAMERA_FRAME
-        image.height, image.width = int(rgb.shape[0]), int(rgb.shape[1])
-        image.encoding = "rgb8"
-        image.step = image.width * 3
-        image.data = rgb.tobytes()
-        self.image_pub.publish(image)
-        info = CameraInfo()
-        info.header = image.header
-        info.height, info.width = image.height, image.width
-        info.distortion_model = "plumb_bob"
-        info.d = [0.0] * 5
-        fx, fy, cx, cy = (
-            float(intrinsics.fx),
-            float(intrinsics.fy),
-            float(intrinsics.cx),
-            float(intrinsics.cy),
-        )
-        info.k = [fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0]
-        info.r = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
-        info.p = [fx, 0.0, cx, 0.0, 0.0, fy, cy, 0.0, 0.0, 0.0, 1.0, 0.0]
-        self.info_pub.publish(info)

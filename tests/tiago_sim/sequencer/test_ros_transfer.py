@@ -25,9 +25,10 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import CameraInfo, Image, JointState, LaserScan
 from std_srvs.srv import Trigger
 
+from robot_port.tiago_interfaces import CAMERA_IMAGE as CAMERA_IMAGE_TOPIC
+from robot_port.tiago_interfaces import CAMERA_INFO as CAMERA_INFO_TOPIC
 from tests.helpers.ros_processes import RosCaller, running
 from tests.helpers.sim_parameters import parameter_request
-from tiago_sim.sim_node.publishers import CAMERA_IMAGE_TOPIC, CAMERA_INFO_TOPIC
 from tiago_twin.lab_reset import RESET_SERVICE
 
 PLATE = "plate_001"
@@ -261,12 +262,12 @@ def seconds(stamp: object) -> float:
 
 
 def test_laser_scan_and_localised_pose_are_published_with_their_frames(robot: RosCaller) -> None:
-    robot.subscribe(LaserScan, "/scan")
+    robot.subscribe(LaserScan, "/scan_raw")
     subscribe_latched(robot, PoseWithCovarianceStamped, "/amcl_pose")
     subscribe_latched(robot, TransformStamped, "/map_to_odom")
-    topics = ("/scan", "/amcl_pose", "/map_to_odom")
+    topics = ("/scan_raw", "/amcl_pose", "/map_to_odom")
     robot.wait_for(lambda: all(t in robot.latest for t in topics), 20.0, "laser and localisation topics")
-    scan = robot.latest["/scan"]
+    scan = robot.latest["/scan_raw"]
     assert scan.header.frame_id == "base_laser_link" and len(scan.ranges) == 661
     assert scan.angle_min == pytest.approx(math.radians(-110), abs=1e-6) and scan.range_max == 10.0
     seen = [r for r in scan.ranges if math.isfinite(r)]

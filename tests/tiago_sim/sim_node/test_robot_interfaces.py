@@ -1,27 +1,40 @@
-"""The simulator's joint trajectory controllers, spoken to as a TIAGo++'s are (tiago_twin --robot-interfaces).
+"""The simulator spoken to as a TIAGo++ is, through the robot's own ROS 2 interfaces (tiago_twin
+--robot-interfaces; the names and types in robot_port.tiago_interfaces).
 
-A real rclpy client sends control_msgs/FollowJointTrajectory goals over DDS to the twin in its own
-process; the joints move in PyBullet and are read back from /joint_states. The controllers behave
-as ros2_controllers' JointTrajectoryController does: invalid goals are rejected, a new goal
-preempts the running one, a cancel stops the joints where they are.
+A real rclpy client talks over DDS to the twin in its own process; joints and base move in
+PyBullet and are read back from /joint_states and the ground truth. The controllers behave as
+ros2_controllers' JointTrajectoryController does: invalid goals are rejected, a new goal preempts
+the running one, a cancel stops the joints where they are. The base takes velocity commands as
+diff_drive_controller does and navigation goals as Nav2 does.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator
 
 import pytest
 from action_msgs.msg import GoalStatus
 from builtin_interfaces.msg import Duration
 from control_msgs.action import FollowJointTrajectory
+from geometry_msgs.msg import Pose2D, PoseStamped, Twist
+from labware_interfaces.action import Undock
+from nav2_msgs.action import NavigateToPose
+from nav_msgs.msg import Odometry
 from rclpy.action import get_action_names_and_types
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectoryPoint
 
-from lab_description.world import DEFAULT_WORLD
+from lab_description.world import DEFAULT_WORLD, load_world
+from robot_port.tiago_interfaces import (
+    CMD_VEL,
+    NAVIGATE_TO_POSE,
+    ODOMETRY,
+    controller_action,
+)
 from robot_port.types import JOINT_GROUPS
 from tests.helpers.ros_processes import RosCaller, running
-from tiago_sim.sim_node.controllers import controller_action, controller_joints
+from tiago_sim.sim_node.controllers import controller_joints
 
 HEAD = controller_action("head")
 TORSO = controller_action("torso")
@@ -35,6 +48,8 @@ def robot(tmp_path_factory: pytest.TempPathFactory) -> Iterator[RosCaller]:
     with running("tiago_twin", *arguments, "--realtime-factor-cap", "5", log_path=log_path):
         caller = RosCaller("test_robot_controllers")
         caller.subscribe(JointState, "/joint_states")
+        caller.subscribe(Odometry, ODOMETRY)
+        caller.subscribe(Pose2D, "/ground_truth/base_pose")
         try:
             caller.wait_for(lambda: "/joint_states" in caller.latest, 120.0, "the twin's /joint_states")
             yield caller
@@ -160,3 +175,54 @@ def test_a_gripper_goal_closes_and_opens_the_fingers(robot: RosCaller) -> None:
     opened = robot.call_action(FollowJointTrajectory, action, goal(names, (1.0, [0.044, 0.044], None)), 60.0)
     assert opened.result.error_code == FollowJointTrajectory.Result.SUCCESSFUL
     assert min(joints_now(robot)[name] for name in names) > 0.04
+
+
+def undocked(robot: RosCaller) -> None:
+    outcome = robot.call_action(Undock, "/undock", Undock.Goal(), 120.0)
+    assert outcome.result.success or "not docked" in outcome.result.message, outcome.result.message
+
+
+def test_a_velocity_command_drives_the_base_until_it_stops_coming(robot: RosCaller) -> None:
+    undocked(robot)
+    publisher = robot.node.create_publisher(Twist, CMD_VEL, 10)
+    robot.wait_for(lambda: publisher.get_subscription_count() > 0, 30.0, "the velocity input")
+    robot.latest.pop(ODOMETRY, None)
+    robot.wait_for(lambda: ODOMETRY in robot.latest, 30.0, "odometry")
+    before = robot.latest[ODOMETRY].pose.pose.position
+    command = Twist()
+    command.linear.x = 0.1
+    for _ in range(20):  # 1 s of wall time, 5 s of robot time at the twin's pace cap
+        publisher.publish(command)
+        robot.spin_for(0.05)
+    robot.spin_for(1.0)  # the command runs out (0.5 s of robot time) and the base brakes
+    robot.latest.pop(ODOMETRY, None)
+    robot.wait_for(lambda: ODOMETRY in robot.latest, 30.0, "odometry")
+    stopped = robot.latest[ODOMETRY].pose.pose.position
+    robot.spin_for(1.0)
+    robot.latest.pop(ODOMETRY, None)
+    robot.wait_for(lambda: ODOMETRY in robot.latest, 30.0, "odometry")
+    later = robot.latest[ODOMETRY].pose.pose.position
+    robot.node.destroy_publisher(publisher)
+    assert math.hypot(stopped.x - before.x, stopped.y - before.y) > 0.1, "the base did not drive"
+    assert math.hypot(later.x - stopped.x, later.y - stopped.y) < 0.002, "the base drove on without commands"
+
+
+def test_a_navigation_goal_brings_the_base_to_the_pose(robot: RosCaller) -> None:
+    undocked(robot)
+    world = load_world(DEFAULT_WORLD)
+    station = world.stations[0]
+    target = station.work_pose()
+    request = NavigateToPose.Goal(pose=PoseStamped())
+    request.pose.header.frame_id = "map"
+    request.pose.pose.position.x, request.pose.pose.position.y = target.x, target.y
+    request.pose.pose.orientation.z, request.pose.pose.orientation.w = (
+        math.sin(target.yaw / 2),
+        math.cos(target.yaw / 2),
+    )
+    outcome = robot.call_action(NavigateToPose, NAVIGATE_TO_POSE, request, 180.0)
+    assert outcome.status == GoalStatus.STATUS_SUCCEEDED
+    robot.latest.pop("/ground_truth/base_pose", None)
+    robot.wait_for(lambda: "/ground_truth/base_pose" in robot.latest, 30.0, "the true pose")
+    truth = robot.latest["/ground_truth/base_pose"]
+    assert math.hypot(truth.x - target.x, truth.y - target.y) < 0.25  # Nav2's default goal checker
+    assert abs(math.remainder(truth.theta - target.yaw, math.tau)) < 0.25
