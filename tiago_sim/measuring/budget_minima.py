@@ -4,34 +4,20 @@ Why: to see where a transfer's time goes, each step's robot time is set against 
 limits would allow for what the step actually moved (joint readings and the base's pose before and
 after). The gap is slack some step could win back; the minimum itself no software can beat.
 The limits are the robot model's (tiago_description), the joint ramp the trajectory controller's
-(tiago_sim.physics.arm_controller). Pure functions.
+(robot_port.trajectory_timing). Pure functions.
 """
 
 from __future__ import annotations
 
 import math
-import xml.etree.ElementTree as ET
 from collections.abc import Iterator, Mapping, Sequence
-from functools import cache
 
+from robot_port.trajectory_timing import RAMP_S, trapezoid_duration
 from tiago_description import robot_model as rm
-from tiago_sim.physics.arm_controller import RAMP_S, _trapezoid_duration
 from tiago_sim.physics.base_controller import _profile_s, wrap_angle
 
 FINGER_PREFIX = "gripper_"  # finger joints move with the gripper command, not on a trajectory
 SHORTEST_SEGMENT_M = 0.001  # a drive's segment shorter than this is no segment
-
-
-@cache
-def velocity_limits() -> dict[str, float]:
-    """Each moving joint's velocity limit (rad/s, m/s for the torso and fingers), from the URDF
-    the simulator builds its body from. Joints without a limit (the wheels) are left out."""
-    limits = {}
-    for joint in ET.fromstring(rm.build_urdf()).iter("joint"):
-        limit = joint.find("limit")
-        if limit is not None and limit.get("velocity"):
-            limits[joint.get("name", "")] = float(limit.get("velocity", "0"))
-    return limits
 
 
 def joint_move_min_s(
@@ -49,7 +35,7 @@ def joint_move_min_s(
             slowest, name = seconds, joint
     if slowest <= 0.0:
         return 0.0, ""
-    return _trapezoid_duration(slowest, ramp_s), name
+    return trapezoid_duration(slowest, ramp_s), name
 
 
 def gripper_min_s(

@@ -21,13 +21,13 @@ import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from tiago_description.joint_limits import velocity_limits
 from tiago_sim.measuring.benchmark import GOAL_LINE
 from tiago_sim.measuring.budget_minima import (
     drive_min_s,
     gripper_min_s,
     joint_move_min_s,
     split_joints,
-    velocity_limits,
 )
 
 log = logging.getLogger(__name__)

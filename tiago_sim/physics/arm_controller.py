@@ -10,46 +10,16 @@ Lives on the sim thread.
 
 from __future__ import annotations
 
-import bisect
 from collections.abc import Sequence
 
 import numpy as np
 
+from robot_port.trajectory_timing import profiled_path
 from tiago_sim.physics.motion import CANCELED, Motion
 from tiago_sim.physics.robot_body import RobotBody
 
 SETTLE_TOLERANCE = 0.02  # rad (m for the torso): goal tolerance, as a joint trajectory controller has
 SETTLE_TIMEOUT_S = 1.5
-
-
-RAMP_S = 0.3  # s from rest to a joint's full speed (and back) at speed scale 1
-
-
-def _trapezoid(t: float, total: float, ramp: float) -> tuple[float, float]:
-    """Distance along a path and speed fraction at time t of a trapezoidal speed profile.
-
-    The path takes ``total`` seconds at full speed; the speed ramps linearly up and down over
-    ``ramp`` seconds (a triangle when the path is shorter than that). Why not a quintic blend:
-    its peak speed is 1.875x its mean, so timing it within the velocity limits nearly doubles
-    every move; a trapezoid cruises at the limit.
-    """
-    accel = 1.0 / ramp
-    t_accel = min(ramp, (total * ramp) ** 0.5)
-    cruise_end = total / (accel * t_accel)  # time at which deceleration starts
-    duration = cruise_end + t_accel
-    t = min(max(t, 0.0), duration)
-    peak = accel * t_accel
-    if t < t_accel:
-        return 0.5 * accel * t * t, accel * t
-    if t < cruise_end:
-        return 0.5 * accel * t_accel * t_accel + peak * (t - t_accel), peak
-    left = duration - t
-    return total - 0.5 * accel * left * left, accel * left
-
-
-def _trapezoid_duration(total: float, ramp: float) -> float:
-    t_accel = min(ramp, (total * ramp) ** 0.5)
-    return total / t_accel * ramp + t_accel
 
 
 class TrackedTrajectory(Motion):
@@ -96,12 +66,9 @@ class TrackedTrajectory(Motion):
 
 
 class JointTrajectoryMotion(TrackedTrajectory):
-    """Through ``waypoints`` (dicts of joint targets): linear segments under one speed profile.
-
-    Segments are timed so no joint exceeds ``speed_scale`` times its limit (or take at least
-    ``min_segment_s``); the whole path follows a trapezoidal speed profile, starting and ending at
-    rest, ramping over RAMP_S / speed_scale.
-    """
+    """Through ``waypoints`` (dicts of joint targets) from where the joints stand, timed by the port's
+    rule (robot_port.trajectory_timing: within ``speed_scale`` of each joint's velocity limit, no
+    segment shorter than ``min_segment_s``, one trapezoidal speed profile)."""
 
     def __init__(
         self,
@@ -113,30 +80,15 @@ class JointTrajectoryMotion(TrackedTrajectory):
         resources=frozenset(),
     ) -> None:
         super().__init__(body, name, resources)
-        self.names = list(waypoints[0])
-        start = body.joint_positions()
-        self.points = [np.array([start[n] for n in self.names])]
-        self.points += [np.array([wp[n] for n in self.names]) for wp in waypoints]
-        self.goal = self.points[-1]
-        scale = max(min(speed_scale, 1.0), 0.05)
-        limits = np.array([body.limits[n][2] for n in self.names]) * scale
-        durations = []
-        for a, b in zip(self.points[:-1], self.points[1:], strict=True):
-            durations.append(max(float(np.max(np.abs(b - a) / limits)), min_segment_s))
-        self.path_length = [float(v) for v in np.cumsum([0.0, *durations])]
-        self.ramp_s = RAMP_S / scale
-        self.duration = max(_trapezoid_duration(self.path_length[-1], self.ramp_s), 1e-3)
+        limits = {n: body.limits[n][2] for n in waypoints[0]}
+        self.names, self.path = profiled_path(
+            body.joint_positions(), waypoints, limits, speed_scale, min_segment_s
+        )
+        self.goal = self.path.points[-1]
+        self.duration = self.path.duration
 
     def _sample(self, t: float) -> tuple[np.ndarray, np.ndarray]:
-        total = self.path_length[-1]
-        if total <= 0.0:
-            return self.points[-1], np.zeros(len(self.names))
-        along, speed = _trapezoid(t, total, self.ramp_s)
-        index = min(max(bisect.bisect_right(self.path_length, along) - 1, 0), len(self.points) - 2)
-        segment = max(self.path_length[index + 1] - self.path_length[index], 1e-9)
-        fraction = min((along - self.path_length[index]) / segment, 1.0)
-        a, b = self.points[index], self.points[index + 1]
-        return a + (b - a) * fraction, (b - a) / segment * speed
+        return self.path.sample(t)
 
 
 class TimedTrajectoryMotion(TrackedTrajectory):

@@ -13,10 +13,11 @@ import math
 
 import pytest
 
+from robot_port.trajectory_timing import RAMP_S
 from tiago_description import robot_model as rm
+from tiago_description.joint_limits import velocity_limits
 from tiago_sim.measuring import time_budget
-from tiago_sim.measuring.budget_minima import drive_min_s, gripper_min_s, joint_move_min_s, velocity_limits
-from tiago_sim.physics.arm_controller import RAMP_S
+from tiago_sim.measuring.budget_minima import drive_min_s, gripper_min_s, joint_move_min_s
 
 
 def test_a_joint_move_is_timed_by_its_slowest_joint_under_the_ramp() -> None:
