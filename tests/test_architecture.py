@@ -23,6 +23,7 @@ TOP_PACKAGES = (
     "tiago_skills",
     "tiago_sim",
     "tiago_twin",
+    "tiago_ros_hardware",
     "ros_bridge",
     "sila_labware",
 )
@@ -74,6 +75,8 @@ ALLOWED: dict[str, set[str]] = {
         "tiago_sim.started_by",
         "lab_description",
     },
+    # the hardware port over a TIAGo++'s own ROS 2 interfaces (a real robot, or the simulator's)
+    "tiago_ros_hardware": {"robot_port", "tiago_description"},
     # the start-up: the one unit that imports both the simulator and the skills
     "tiago_twin": {
         "robot_port",

@@ -47,6 +47,8 @@ TORSO_LIFT_RANGE = (0.0, 0.35)
 TORSO_LIFT_SPEED = 0.07
 
 # Gripper
+LASER_MOUNT = (0.202, 0.0, 0.0)
+"""The base laser's frame (base_laser_link) in base_footprint: x, y (m) and yaw (rad)."""
 FINGER_TRAVEL = 0.045
 FINGER_MOUNT_OFFSET = 0.005  # inner pad face at this distance from centre when a finger joint is 0
 FINGER_SPEED = 0.05
@@ -102,6 +104,20 @@ def arm_joint_origins(reflect: int) -> list[tuple[tuple[float, float, float], tu
 def arm_joint_names(side: str) -> list[str]:
     """URDF names of the seven joints of one arm, shoulder first."""
     return [f"arm_{side}_{joint.name}_joint" for joint in ARM_JOINTS]
+
+
+def controller_joints(group: str) -> list[str]:
+    """The joints a controller of the robot moves (robot_port.types.JOINT_GROUPS), in the order of
+    PAL's controller files."""
+    if group.startswith("arm_"):
+        return arm_joint_names(group.removeprefix("arm_"))
+    if group.startswith("gripper_"):
+        return finger_joint_names(group.removeprefix("gripper_"))
+    if group == "torso":
+        return ["torso_lift_joint"]
+    if group == "head":
+        return [f"{joint.name}_joint" for joint in HEAD_JOINTS]
+    raise ValueError(f"no controller for {group!r}")
 
 
 def finger_joint_names(side: str) -> list[str]:

@@ -48,10 +48,10 @@ def laser_rng(seed: int | None) -> np.random.Generator:
 class LaserSpec:
     """The range finder and its mount (SI; angles in rad, counter-clockwise from the laser's x)."""
 
-    mount_x: float = 0.202  # m ahead of base_footprint
-    mount_y: float = 0.0
+    mount_x: float = rm.LASER_MOUNT[0]  # m ahead of base_footprint
+    mount_y: float = rm.LASER_MOUNT[1]
     mount_z: float = rm.WHEEL_RADIUS - 0.004  # 0.0945 m above the floor
-    mount_yaw: float = 0.0
+    mount_yaw: float = rm.LASER_MOUNT[2]
     angle_min: float = -math.radians(110.0)
     angle_max: float = math.radians(110.0)
     angle_increment: float = math.radians(1.0 / 3.0)

@@ -45,19 +45,6 @@ real time that would be thousands a second)."""
 MOTION_ANSWER_TIMEOUT_S = 60.0
 
 
-def controller_joints(group: str) -> list[str]:
-    """The joints a controller moves, in the order of PAL's controller files."""
-    if group.startswith("arm_"):
-        return rm.arm_joint_names(group.removeprefix("arm_"))
-    if group.startswith("gripper_"):
-        return rm.finger_joint_names(group.removeprefix("gripper_"))
-    if group == "torso":
-        return ["torso_lift_joint"]
-    if group == "head":
-        return [f"{joint.name}_joint" for joint in rm.HEAD_JOINTS]
-    raise ValueError(f"no controller for {group!r}")
-
-
 def trajectory_problem(joints: list[str], trajectory: Any) -> str:
     """Why a trajectory_msgs/JointTrajectory is not a valid goal for a controller of `joints`; ""
     when it is."""
@@ -110,7 +97,7 @@ class TrajectoryControllers:
         ]
 
     def _check(self, group: str, goal: Any) -> GoalResponse:
-        problem = trajectory_problem(controller_joints(group), goal.trajectory)
+        problem = trajectory_problem(rm.controller_joints(group), goal.trajectory)
         if problem:
             log.warning("%s: goal rejected: %s", controller_action(group), problem)
             return GoalResponse.REJECT

@@ -195,9 +195,9 @@ class StatePublishers:
         self._publish(snapshot)
 
     def _standing_still(self) -> bool:
-        """No goal ran at the last report, none began or ended since, and it is less than an idle
-        period old (time.monotonic)."""
-        if self.activity_signature is None:
+        """No goal ran at the last report, none began or ended since, nothing moves (a command from
+        the robot's own interfaces runs no goal), and it is less than an idle period old."""
+        if self.activity_signature is None or self.sim_thread.in_motion:
             return False
         signature = self.activity_signature()
         if signature[0] or signature != self._reported_signature:

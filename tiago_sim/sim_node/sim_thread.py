@@ -55,6 +55,7 @@ class SimThread:
         # CPU accounting (load-independent speed): sim seconds advanced while a Motion ran, the
         # thread's CPU seconds for them, and CPU seconds spent in jobs (IK, rendering, snapshots).
         self.busy_sim_s = 0.0
+        self.in_motion = False  # a motion ran at the last batch of steps (a plain flag other threads read)
         self.busy_cpu_s = 0.0
         self.job_cpu_s = 0.0
         self._thread = threading.Thread(target=self._run_maybe_profiled, name="sim", daemon=True)
@@ -171,7 +172,7 @@ class SimThread:
                     wall_start, sim_start, paced_factor = time.monotonic(), sim.sim_time, None
                 cpu_after_jobs = time.thread_time()
                 self.job_cpu_s += cpu_after_jobs - cpu_before
-                busy = sim.busy()
+                busy = self.in_motion = sim.busy()
                 factor = self.realtime_factor_cap if busy else self.idle_realtime_factor
                 if factor == paced_factor and factor is not None and factor > 0:
                     ahead_s = ahead_of_wall_s(factor)

@@ -34,7 +34,7 @@ from robot_port.tiago_interfaces import (
 )
 from robot_port.types import JOINT_GROUPS
 from tests.helpers.ros_processes import RosCaller, running
-from tiago_sim.sim_node.controllers import controller_joints
+from tiago_description.robot_model import controller_joints
 
 HEAD = controller_action("head")
 TORSO = controller_action("torso")

@@ -1,0 +1,168 @@
+"""The hardware port over a TIAGo++'s own ROS 2 interfaces (tiago_ros_hardware), against the twin.
+
+The twin runs in its own process and serves the robot's interfaces (tiago_twin --robot-interfaces,
+paced at 5 times real time: the adapter renews velocity commands on the wall clock); the adapter
+runs here on a real rclpy node over DDS. Every reading and command goes through RosHardware as
+the skills would call it; what moved is read back through the adapter and, for the base, from the
+simulator's ground truth.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import pytest
+import rclpy
+from geometry_msgs.msg import Pose2D as Pose2DMsg
+from labware_interfaces.action import Undock
+from rclpy.executors import MultiThreadedExecutor
+from rclpy.qos import QoSProfile, ReliabilityPolicy
+
+from lab_description.world import DEFAULT_WORLD, load_world
+from robot_port.hardware import RobotHardware
+from robot_port.trajectory_timing import profiled_path
+from robot_port.types import JointTrajectory
+from tests.helpers.ros_processes import RosCaller, running
+from tiago_description import robot_model as rm
+from tiago_description.joint_limits import velocity_limits
+from tiago_ros_hardware.hardware import RosHardware
+
+WAIT_S = 120.0
+
+
+@pytest.fixture(scope="module")
+def robot(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[RosHardware, RosCaller]]:
+    log_path: Path = tmp_path_factory.mktemp("ros_logs") / "twin.log"
+    arguments = [
+        "--world",
+        str(DEFAULT_WORLD),
+        "--seed",
+        "3",
+        "--robot-interfaces",
+        "--realtime-factor-cap",
+        "5",
+    ]
+    with running("tiago_twin", *arguments, log_path=log_path):
+        caller = RosCaller("test_ros_hardware_caller")  # the in-process skills' actions (undock)
+        node = rclpy.create_node("test_ros_hardware")
+        executor = MultiThreadedExecutor(num_threads=4)
+        executor.add_node(node)
+        spinner = threading.Thread(target=executor.spin, daemon=True)
+        spinner.start()
+        try:
+            hardware = RosHardware(node)
+            hardware.joint_positions()  # the twin is up and publishing
+            yield hardware, caller
+        finally:
+            executor.shutdown()
+            spinner.join(timeout=10.0)
+            node.destroy_node()
+            caller.close()
+
+
+def finished(execution, timeout_s: float = WAIT_S):  # noqa: ANN001, ANN201
+    assert execution.wait(timeout_s), f"{execution.name} did not end"
+    return execution
+
+
+def test_the_adapter_is_a_hardware_port(robot: tuple[RosHardware, RosCaller]) -> None:
+    hardware, _caller = robot
+    assert isinstance(hardware, RobotHardware)
+    joints = hardware.joint_positions()
+    assert set(rm.arm_joint_names("right")) <= joints.keys() and "torso_lift_joint" in joints
+    dock = load_world(DEFAULT_WORLD).dock_pose
+    x, y, _yaw = hardware.pose_estimate()
+    assert math.hypot(x - dock.x, y - dock.y) < 0.2, "the believed pose is not at the dock"
+
+
+def test_a_trajectory_over_two_controllers_arrives_in_the_ports_time(
+    robot: tuple[RosHardware, RosCaller],
+) -> None:
+    hardware, _caller = robot
+    start = hardware.joint_positions()
+    target = {
+        "head_1_joint": start["head_1_joint"] + 0.4,
+        "torso_lift_joint": min(start["torso_lift_joint"] + 0.05, 0.34),
+    }
+    trajectory = JointTrajectory((target,), name="head_and_torso")
+    _names, path = profiled_path(start, trajectory.points, velocity_limits())
+    began = hardware.now()
+    execution = finished(hardware.follow_joint_trajectory(trajectory))
+    took = hardware.now() - began
+    assert execution.success, execution.message
+    now = hardware.joint_positions()
+    assert [now[name] for name in target] == pytest.approx(list(target.values()), abs=0.01)
+    # the controllers ran the port's timing: the same duration, to the clock's ticks (20 a second of
+    # wall time, 0.25 s of robot time at the pace of 5) at either end
+    assert took == pytest.approx(path.duration, abs=0.75)
+
+
+def test_a_group_in_motion_is_busy_and_a_cancel_stops_it(robot: tuple[RosHardware, RosCaller]) -> None:
+    hardware, _caller = robot
+    start = hardware.joint_positions()
+    slow = JointTrajectory(({"head_1_joint": start["head_1_joint"] - 0.6},), speed_scale=0.05, name="slow")
+    running_move = hardware.follow_joint_trajectory(slow)
+    busy = hardware.follow_joint_trajectory(JointTrajectory(({"head_2_joint": -0.3},)))
+    assert busy.done and busy.error_code == "BUSY"
+    running_move.cancel()
+    finished(running_move)
+    assert running_move.error_code == "CANCELED"
+    assert (
+        hardware.follow_joint_trajectory(JointTrajectory(({"head_9_joint": 0.0},))).error_code == "BAD_GOAL"
+    )
+
+
+def test_the_gripper_says_whether_it_holds_from_its_fingers(robot: tuple[RosHardware, RosCaller]) -> None:
+    hardware, _caller = robot
+    closed = finished(hardware.gripper("left", close=True))
+    assert closed.success and closed.result["holding"] is False  # nothing between the fingers
+    assert closed.result["opening_m"] < 2 * rm.FINGER_MOUNT_OFFSET + 0.002
+    opened = finished(hardware.gripper("left", close=False))
+    assert opened.success and opened.result["opening_m"] > 0.08
+
+
+def test_a_camera_frame_comes_with_the_joints_of_its_instant(robot: tuple[RosHardware, RosCaller]) -> None:
+    hardware, _caller = robot
+    asked = hardware.now()
+    frame = hardware.capture_head_camera()
+    assert frame.stamp_s >= asked
+    assert frame.rgb.shape == (480, 640, 3) and frame.depth.shape == (480, 640)
+    assert np.isfinite(frame.depth).mean() > 0.5 and frame.rgb.std() > 1.0
+    assert frame.intrinsics.fx == pytest.approx(522.2, abs=0.1)
+    assert "head_2_joint" in frame.joints
+
+
+def test_a_laser_scan_covers_the_lasers_field(robot: tuple[RosHardware, RosCaller]) -> None:
+    hardware, _caller = robot
+    scan = hardware.laser_scan()
+    assert scan.mount == rm.LASER_MOUNT
+    assert len(scan.ranges) > 600 and np.isfinite(scan.ranges).any()
+
+
+def test_the_base_drives_to_an_odometry_pose_and_navigates_to_a_station(
+    robot: tuple[RosHardware, RosCaller],
+) -> None:
+    hardware, caller = robot
+    outcome = caller.call_action(Undock, "/undock", Undock.Goal(), WAIT_S)
+    assert outcome.result.success, outcome.result.message
+    x, y, yaw = hardware.odometry()
+    goal = (x + 0.2 * math.cos(yaw), y + 0.2 * math.sin(yaw), yaw + math.radians(10))
+    drive = finished(hardware.drive_to(goal, 0.3))
+    assert drive.success, drive.message
+    gx, gy, gyaw = hardware.odometry()
+    assert math.hypot(gx - goal[0], gy - goal[1]) < 0.015  # the drive's 1 cm, and the braking after
+    assert abs(math.remainder(gyaw - goal[2], math.tau)) < math.radians(1.0)
+
+    station = load_world(DEFAULT_WORLD).stations[0]
+    target = station.work_pose()
+    navigation = finished(hardware.navigate_to((target.x, target.y, target.yaw), station.poi))
+    assert navigation.success, navigation.message
+    truth: list[Pose2DMsg] = []
+    qos = QoSProfile(depth=5, reliability=ReliabilityPolicy.RELIABLE)
+    caller.node.create_subscription(Pose2DMsg, "/ground_truth/base_pose", truth.append, qos)
+    caller.wait_for(lambda: bool(truth), 30.0, "the true pose")
+    assert math.hypot(truth[-1].x - target.x, truth[-1].y - target.y) < 0.25

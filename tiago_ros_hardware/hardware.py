@@ -1,0 +1,340 @@
+"""RosHardware: robot_port.RobotHardware over a TIAGo++'s own ROS 2 interfaces.
+
+Readings come from the robot's topics (topics.TopicHistory): a reading waits for a message stamped
+at or after the robot's time of the call, so it shows the robot as it stands then. Commands are
+goals to the robot's controllers and to Nav2 (executions.GoalsExecution), or loops the adapter
+closes itself over the velocity command and odometry (executions.LoopExecution): the port's
+short straight drive has no standard interface on a robot.
+
+Where a TIAGo++ has no sensor for what the port offers, the adapter derives it: whether the
+gripper holds something comes from the fingers' joint positions after closing (they stop apart on a
+plate), not from a contact sensor. Docking is not offered yet: its calls raise HardwareUnavailable.
+
+The names and types are robot_port.tiago_interfaces'. Localisation's correction comes from
+`/map_to_odom` (the simulator's topic for what a robot's `/tf` carries as map -> odom).
+
+Threads: the node's callbacks on its executor's threads (the caller spins the node, with threads to
+spare for the goals' answers); every port method on any thread.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from typing import Any
+
+import numpy as np
+from control_msgs.action import FollowJointTrajectory
+from geometry_msgs.msg import PoseStamped, TransformStamped, Twist
+from nav2_msgs.action import NavigateToPose
+from nav_msgs.msg import Odometry
+from rclpy.action import ActionClient
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import CameraInfo, Image, JointState
+from sensor_msgs.msg import LaserScan as LaserScanMsg
+from trajectory_msgs.msg import JointTrajectoryPoint
+
+from robot_port.execution import Execution
+from robot_port.hardware import HardwareUnavailable
+from robot_port.tiago_interfaces import (
+    CAMERA_DEPTH,
+    CAMERA_IMAGE,
+    CAMERA_INFO,
+    CMD_VEL,
+    JOINT_STATES,
+    LASER,
+    NAVIGATE_TO_POSE,
+    ODOMETRY,
+    controller_action,
+)
+from robot_port.types import JOINT_GROUPS, CameraFrame, CameraIntrinsics, JointTrajectory, LaserScan, Pose2D
+from tiago_description import robot_model as rm
+from tiago_description import transforms as tf
+from tiago_description.joint_limits import velocity_limits
+from tiago_ros_hardware.base_loops import drive_loop, velocity_loop
+from tiago_ros_hardware.executions import FailedExecution, GoalsExecution, LoopExecution
+from tiago_ros_hardware.topics import TopicHistory, stamp_seconds
+from tiago_ros_hardware.trajectory_goals import controller_goals, duration_msg
+
+READING_TIMEOUT_S = 30.0
+"""Wall seconds a reading may wait for its topic before the robot counts as gone."""
+CORRECTION_TOPIC = "/map_to_odom"
+NAVIGATION_SPEED_MPS = 0.5  # for the time-left estimate of a navigation goal only
+HOLDING_GAP_M = 2 * rm.FINGER_MOUNT_OFFSET + 0.002
+"""Fingers that stop closing with their pads further apart than this hold something."""
+
+
+def yaw_of(orientation: Any) -> float:
+    q = orientation
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+class RosHardware:
+    """robot_port.RobotHardware on the robot's ROS 2 interfaces, through `node`."""
+
+    def __init__(self, node: Node) -> None:
+        self.node = node
+        self._group = ReentrantCallbackGroup()
+        self._lock = threading.Lock()
+        self._busy: dict[str, Execution] = {}
+        self._clock_s: float | None = None
+        self._clock_changed = threading.Condition()
+        self._correction: Pose2D = (0.0, 0.0, 0.0)
+        self.joints = TopicHistory(JOINT_STATES)
+        self.odom = TopicHistory(ODOMETRY)
+        self.scans = TopicHistory(LASER)
+        self.images = TopicHistory(CAMERA_IMAGE)
+        self.depths = TopicHistory(CAMERA_DEPTH)
+        self.infos = TopicHistory(CAMERA_INFO)
+        reliable = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
+        latched = QoSProfile(
+            depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
+        )
+        self._subscribe(Clock, "/clock", self._on_clock, reliable)
+        self._subscribe(JointState, JOINT_STATES, self._on_joints, reliable)
+        self._subscribe(Odometry, ODOMETRY, self._on_odometry, reliable)
+        self._subscribe(TransformStamped, CORRECTION_TOPIC, self._on_correction, latched)
+        self._sensors_subscribed: set[str] = set()
+        self._settled = {"joints": 0, "odom": 0}  # counts after which a reading shows the robot at rest
+        self.cmd_vel = node.create_publisher(Twist, CMD_VEL, reliable)
+        self.controllers = {
+            group: ActionClient(
+                node, FollowJointTrajectory, controller_action(group), callback_group=self._group
+            )
+            for group in JOINT_GROUPS
+        }
+        self.navigation = ActionClient(node, NavigateToPose, NAVIGATE_TO_POSE, callback_group=self._group)
+        self.limits = velocity_limits()
+
+    def _subscribe(self, kind: Any, topic: str, callback: Any, qos: QoSProfile) -> None:
+        self.node.create_subscription(kind, topic, callback, qos, callback_group=self._group)
+
+    # -- topics -> histories --------------------------------------------------------------------
+    def _on_clock(self, message: Clock) -> None:
+        with self._clock_changed:
+            self._clock_s = message.clock.sec + message.clock.nanosec * 1e-9
+            self._clock_changed.notify_all()
+
+    def _on_joints(self, message: JointState) -> None:
+        self.joints.add(dict(zip(message.name, message.position, strict=True)), stamp_seconds(message))
+
+    def _on_odometry(self, message: Odometry) -> None:
+        pose = message.pose.pose
+        planar = (float(pose.position.x), float(pose.position.y), yaw_of(pose.orientation))
+        twist = message.twist.twist
+        self.odom.add((planar, (float(twist.linear.x), float(twist.angular.z))), stamp_seconds(message))
+
+    def _on_correction(self, message: TransformStamped) -> None:
+        t = message.transform
+        self._correction = (float(t.translation.x), float(t.translation.y), yaw_of(t.rotation))
+
+    # -- clock and readings --------------------------------------------------------------------
+    def now(self) -> float:
+        with self._clock_changed:
+            if not self._clock_changed.wait_for(lambda: self._clock_s is not None, READING_TIMEOUT_S):
+                raise HardwareUnavailable("no /clock from the robot")
+            return float(self._clock_s)
+
+    def _now_or_zero(self) -> float:
+        return float(self._clock_s or 0.0)
+
+    def joint_positions(self) -> dict[str, float]:
+        return dict(self.joints.after(self._settled["joints"], READING_TIMEOUT_S)[1])
+
+    def odometry(self) -> Pose2D:
+        return self._fresh_odometry()[0]
+
+    def _fresh_odometry(self) -> tuple[Pose2D, tuple[float, float]]:
+        return self.odom.after(self._settled["odom"], READING_TIMEOUT_S)[1]
+
+    def _command_ended(self) -> None:
+        """Readings from now on wait for messages sent after the end: the next but one of each topic."""
+        self._settled = {"joints": self.joints.count + 1, "odom": self.odom.count + 1}
+
+    def pose_estimate(self) -> Pose2D:
+        return tf.compose_planar(self._correction, self.odometry())
+
+    def is_docked(self) -> bool:
+        raise HardwareUnavailable("docking is not offered over ROS yet (docs/reference/robot-interfaces.md)")
+
+    def laser_scan(self) -> LaserScan:
+        self._subscribe_sensor(LASER, LaserScanMsg, self.scans)
+        settled, _odometry = self.odom.after(self._settled["odom"], READING_TIMEOUT_S)
+        stamp, message = self.scans.newer_than(settled - 1e-9, READING_TIMEOUT_S)
+        odometry = self.odom.at(stamp)
+        ranges = np.array(message.ranges, dtype=float)
+        ranges[~np.isfinite(ranges) | (ranges > message.range_max)] = np.inf
+        return LaserScan(
+            ranges=ranges,
+            angle_min=float(message.angle_min),
+            angle_increment=float(message.angle_increment),
+            range_min=float(message.range_min),
+            range_max=float(message.range_max),
+            mount=rm.LASER_MOUNT,
+            odometry=odometry[0] if odometry is not None else self.odometry(),
+            stamp_s=stamp,
+        )
+
+    def capture_head_camera(self) -> CameraFrame:
+        for topic, kind, history in (
+            (CAMERA_IMAGE, Image, self.images),
+            (CAMERA_DEPTH, Image, self.depths),
+            (CAMERA_INFO, CameraInfo, self.infos),
+        ):
+            self._subscribe_sensor(topic, kind, history)
+        settled, _joints = self.joints.after(self._settled["joints"], READING_TIMEOUT_S)
+        stamp, image = self.images.newer_than(settled - 1e-9, READING_TIMEOUT_S)  # rendered since
+        _, depth = self.depths.newer_than(stamp - 1e-9, READING_TIMEOUT_S)
+        _, info = self.infos.newer_than(stamp - 1e-9, READING_TIMEOUT_S)
+        rgb = np.frombuffer(bytes(image.data), dtype=np.uint8).reshape(image.height, image.width, 3)
+        metres = np.frombuffer(bytes(depth.data), dtype=np.float32).reshape(depth.height, depth.width)
+        k = info.k
+        intrinsics = CameraIntrinsics(
+            width=info.width, height=info.height, fx=k[0], fy=k[4], cx=k[2], cy=k[5]
+        )
+        joints = self.joints.at(stamp) or self.joint_positions()
+        odometry = self.odom.at(stamp)
+        return CameraFrame(
+            rgb.copy(),
+            metres.copy(),
+            intrinsics,
+            dict(joints),
+            odometry[0] if odometry else self.odometry(),
+            stamp,
+        )
+
+    def _subscribe_sensor(self, topic: str, kind: Any, history: TopicHistory) -> None:
+        """Subscribe on first use: the camera renders and the laser scans only while someone listens."""
+        with self._lock:
+            if topic in self._sensors_subscribed:
+                return
+            self._sensors_subscribed.add(topic)
+        self._subscribe(kind, topic, history.add, QoSProfile(depth=2, reliability=ReliabilityPolicy.RELIABLE))
+
+    # -- commands ------------------------------------------------------------------------------
+    def _claim(self, groups: set[str], execution: Any) -> Execution:
+        """`execution` (a callable starting it) unless one of `groups` is moving for another command."""
+        with self._lock:
+            taken = sorted(g for g in groups if g in self._busy and not self._busy[g].done)
+            if taken:
+                return FailedExecution("busy", "BUSY", f"busy: {taken}")
+            started = execution()
+            for group in groups:
+                self._busy[group] = started
+        return started
+
+    def follow_joint_trajectory(self, trajectory: JointTrajectory) -> Execution:
+        unknown = [name for name in trajectory.joint_names if name not in self.limits]
+        if unknown or not trajectory.points:
+            why = f"joints the robot does not have: {unknown}" if unknown else "no points"
+            return FailedExecution(trajectory.name, "BAD_GOAL", why)
+        start = self.joint_positions()
+        goals, duration = controller_goals(trajectory, start, self.limits)
+        sent = [(controller_action(group), self.controllers[group], goal) for group, goal in goals.items()]
+        return self._claim(
+            set(goals),
+            lambda: GoalsExecution(
+                trajectory.name,
+                sent,
+                self._now_or_zero,
+                duration,
+                "MOTION_FAILED",
+                on_end=self._command_ended,
+            ),
+        )
+
+    def gripper(self, side: str, close: bool) -> Execution:
+        if side not in rm.ARM_SIDES:
+            return FailedExecution("gripper", "BAD_GOAL", f"unknown arm {side!r}")
+        group = f"gripper_{side}"
+        fingers = rm.finger_joint_names(side)
+        target = 0.0 if close else rm.FINGER_TRAVEL - 0.001
+        seconds = rm.FINGER_TRAVEL / rm.FINGER_SPEED
+        goal = FollowJointTrajectory.Goal()
+        goal.trajectory.joint_names = fingers
+        point = JointTrajectoryPoint(positions=[target] * len(fingers), time_from_start=duration_msg(seconds))
+        goal.trajectory.points.append(point)
+
+        def reading() -> dict[str, Any]:
+            joints = self.joint_positions()
+            opening = 2 * rm.FINGER_MOUNT_OFFSET + sum(joints[name] for name in fingers)
+            return {"holding": bool(close and opening > HOLDING_GAP_M), "opening_m": opening}
+
+        sent = [(controller_action(group), self.controllers[group], goal)]
+        name = f"gripper_{side}_{'close' if close else 'open'}"
+        return self._claim(
+            {group},
+            lambda: GoalsExecution(
+                name, sent, self._now_or_zero, seconds, "GRASP_FAILED", reading, self._command_ended
+            ),
+        )
+
+    def command_velocity(self, linear_mps: float, angular_radps: float, duration_s: float) -> Execution:
+        return self._claim(
+            {"base"},
+            lambda: LoopExecution(
+                "velocity", self._now_or_zero, duration_s,
+                lambda run: velocity_loop(self, run, linear_mps, angular_radps, duration_s),
+                self._command_ended,
+            ),
+        )  # fmt: skip
+
+    def drive_to(self, goal: Pose2D, speed_mps: float) -> Execution:
+        here = self.odometry()
+        seconds = math.dist(goal[:2], here[:2]) / max(speed_mps, 1e-3) + 1.0
+        return self._claim(
+            {"base"},
+            lambda: LoopExecution(
+                "drive",
+                self._now_or_zero,
+                seconds,
+                lambda run: drive_loop(self, run, goal, speed_mps),
+                self._command_ended,
+            ),
+        )
+
+    def navigate_to(self, goal: Pose2D, goal_name: str) -> Execution:
+        request = NavigateToPose.Goal(pose=PoseStamped())
+        request.pose.header.frame_id = "map"
+        request.pose.pose.position.x, request.pose.pose.position.y = float(goal[0]), float(goal[1])
+        request.pose.pose.orientation.z = math.sin(goal[2] / 2)
+        request.pose.pose.orientation.w = math.cos(goal[2] / 2)
+        here = self.pose_estimate()
+        seconds = math.dist(goal[:2], here[:2]) / NAVIGATION_SPEED_MPS + abs(
+            math.remainder(goal[2] - here[2], math.tau)
+        )
+        sent = [(NAVIGATE_TO_POSE, self.navigation, request)]
+        return self._claim(
+            {"base"},
+            lambda: GoalsExecution(
+                f"navigate to {goal_name}",
+                sent,
+                self._now_or_zero,
+                seconds,
+                "NAVIGATION_FAILED",
+                on_end=self._command_ended,
+            ),
+        )
+
+    def dock(self) -> Execution:
+        return FailedExecution("dock", "INTERNAL", "docking is not offered over ROS yet")
+
+    def undock(self) -> Execution:
+        return FailedExecution("undock", "INTERNAL", "docking is not offered over ROS yet")
+
+    # -- for the loops -------------------------------------------------------------------------
+    def publish_twist(self, linear: float, angular: float) -> None:
+        twist = Twist()
+        twist.linear.x, twist.angular.z = float(linear), float(angular)
+        self.cmd_vel.publish(twist)
+
+    def base_motion(self) -> tuple[Pose2D, tuple[float, float]]:
+        """The base's odometry pose and its speeds (linear m/s, angular rad/s), fresh."""
+        return self._fresh_odometry()
+
+    def next_base_motion(self) -> tuple[Pose2D, tuple[float, float]]:
+        """As `base_motion`, from the next odometry message to arrive (a loop's next step)."""
+        return self.odom.after(self.odom.count, READING_TIMEOUT_S)[1]
