@@ -36,6 +36,9 @@ CAMERA_INFO = "/head_front_camera/rgb/camera_info"
 CAMERA_DEPTH = "/head_front_camera/depth_registered/image_raw"
 JOINT_STATES = "/joint_states"
 NAVIGATE_TO_POSE = "/navigate_to_pose"
+DOCK_ROBOT = "/dock_robot"
+UNDOCK_ROBOT = "/undock_robot"
+BATTERY_STATE = "/battery_state"
 
 TIAGO_INTERFACES: tuple[RosInterface, ...] = (
     *(
@@ -58,6 +61,9 @@ TIAGO_INTERFACES: tuple[RosInterface, ...] = (
     RosInterface(JOINT_STATES, "sensor_msgs/msg/JointState", "topic", "every joint's reading"),
     RosInterface("/clock", "rosgraph_msgs/msg/Clock", "topic", "the simulator's time (a simulation only)"),
     RosInterface(NAVIGATE_TO_POSE, "nav2_msgs/action/NavigateToPose", "action", "Nav2's navigation goal"),
+    # lab-added: Nav2's docking server and the battery state its charging dock reads
+    RosInterface(DOCK_ROBOT, "nav2_msgs/action/DockRobot", "action", "onto the charging dock"),
+    RosInterface(UNDOCK_ROBOT, "nav2_msgs/action/UndockRobot", "action", "off the charging dock"),
+    RosInterface(BATTERY_STATE, "sensor_msgs/msg/BatteryState", "topic", "charging while on the dock"),
 )
-"""What the simulator serves today. Not yet: /tf and /tf_static, /play_motion2, and docking (whose
-Humble definition could not be read here: docs/reference/robot-interfaces.md)."""
+"""What the simulator serves today. Not yet: /tf and /tf_static, and /play_motion2."""

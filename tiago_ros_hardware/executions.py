@@ -132,7 +132,11 @@ class GoalsExecution(_Outcome):
             elif status == GoalStatus.STATUS_CANCELED:
                 self._failures.append(("CANCELED", "canceled"))
             elif status != GoalStatus.STATUS_SUCCEEDED:
-                why = getattr(result, "error_string", "") or f"status {status}"
+                why = (
+                    getattr(result, "error_string", "")
+                    or getattr(result, "error_msg", "")
+                    or f"status {status}"
+                )
                 self._failures.append((self._failure_code, f"{action}: {why}"))
             left, failures = self._waiting, list(self._failures)
         if left > 0:

@@ -8,7 +8,9 @@ short straight drive has no standard interface on a robot.
 
 Where a TIAGo++ has no sensor for what the port offers, the adapter derives it: whether the
 gripper holds something comes from the fingers' joint positions after closing (they stop apart on a
-plate), not from a contact sensor. Docking is not offered yet: its calls raise HardwareUnavailable.
+plate), not from a contact sensor. Docking is the lab's: Nav2's docking server (`dock_id` names the
+lab's dock; "" for its only one), and whether the robot is docked is the battery charging, as
+Nav2's charging dock reads it from `/battery_state`.
 
 The names and types are robot_port.tiago_interfaces'. Localisation's correction comes from
 `/map_to_odom` (the simulator's topic for what a robot's `/tf` carries as map -> odom).
@@ -26,28 +28,31 @@ from typing import Any
 import numpy as np
 from control_msgs.action import FollowJointTrajectory
 from geometry_msgs.msg import PoseStamped, TransformStamped, Twist
-from nav2_msgs.action import NavigateToPose
+from nav2_msgs.action import DockRobot, NavigateToPose, UndockRobot
 from nav_msgs.msg import Odometry
 from rclpy.action import ActionClient
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
-from sensor_msgs.msg import CameraInfo, Image, JointState
+from sensor_msgs.msg import BatteryState, CameraInfo, Image, JointState
 from sensor_msgs.msg import LaserScan as LaserScanMsg
 from trajectory_msgs.msg import JointTrajectoryPoint
 
 from robot_port.execution import Execution
 from robot_port.hardware import HardwareUnavailable
 from robot_port.tiago_interfaces import (
+    BATTERY_STATE,
     CAMERA_DEPTH,
     CAMERA_IMAGE,
     CAMERA_INFO,
     CMD_VEL,
+    DOCK_ROBOT,
     JOINT_STATES,
     LASER,
     NAVIGATE_TO_POSE,
     ODOMETRY,
+    UNDOCK_ROBOT,
     controller_action,
 )
 from robot_port.types import JOINT_GROUPS, CameraFrame, CameraIntrinsics, JointTrajectory, LaserScan, Pose2D
@@ -63,6 +68,7 @@ READING_TIMEOUT_S = 30.0
 """Wall seconds a reading may wait for its topic before the robot counts as gone."""
 CORRECTION_TOPIC = "/map_to_odom"
 NAVIGATION_SPEED_MPS = 0.5  # for the time-left estimate of a navigation goal only
+DOCKING_S = 8.0  # for the time-left estimate of docking and undocking only
 HOLDING_GAP_M = 2 * rm.FINGER_MOUNT_OFFSET + 0.002
 """Fingers that stop closing with their pads further apart than this hold something."""
 
@@ -75,8 +81,9 @@ def yaw_of(orientation: Any) -> float:
 class RosHardware:
     """robot_port.RobotHardware on the robot's ROS 2 interfaces, through `node`."""
 
-    def __init__(self, node: Node) -> None:
+    def __init__(self, node: Node, dock_id: str = "") -> None:
         self.node = node
+        self.dock_id = dock_id
         self._group = ReentrantCallbackGroup()
         self._lock = threading.Lock()
         self._busy: dict[str, Execution] = {}
@@ -89,6 +96,7 @@ class RosHardware:
         self.images = TopicHistory(CAMERA_IMAGE)
         self.depths = TopicHistory(CAMERA_DEPTH)
         self.infos = TopicHistory(CAMERA_INFO)
+        self.battery = TopicHistory(BATTERY_STATE)
         reliable = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
         latched = QoSProfile(
             depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
@@ -97,8 +105,9 @@ class RosHardware:
         self._subscribe(JointState, JOINT_STATES, self._on_joints, reliable)
         self._subscribe(Odometry, ODOMETRY, self._on_odometry, reliable)
         self._subscribe(TransformStamped, CORRECTION_TOPIC, self._on_correction, latched)
+        self._subscribe(BatteryState, BATTERY_STATE, self.battery.add, reliable)
         self._sensors_subscribed: set[str] = set()
-        self._settled = {"joints": 0, "odom": 0}  # counts after which a reading shows the robot at rest
+        self._settled = {"joints": 0, "odom": 0, "battery": 0}  # counts after which readings show it at rest
         self.cmd_vel = node.create_publisher(Twist, CMD_VEL, reliable)
         self.controllers = {
             group: ActionClient(
@@ -107,6 +116,8 @@ class RosHardware:
             for group in JOINT_GROUPS
         }
         self.navigation = ActionClient(node, NavigateToPose, NAVIGATE_TO_POSE, callback_group=self._group)
+        self.docking = ActionClient(node, DockRobot, DOCK_ROBOT, callback_group=self._group)
+        self.undocking = ActionClient(node, UndockRobot, UNDOCK_ROBOT, callback_group=self._group)
         self.limits = velocity_limits()
 
     def _subscribe(self, kind: Any, topic: str, callback: Any, qos: QoSProfile) -> None:
@@ -152,13 +163,17 @@ class RosHardware:
 
     def _command_ended(self) -> None:
         """Readings from now on wait for messages sent after the end: the next but one of each topic."""
-        self._settled = {"joints": self.joints.count + 1, "odom": self.odom.count + 1}
+        self._settled = {name: history.count + 1 for name, history in self._histories().items()}
+
+    def _histories(self) -> dict[str, TopicHistory]:
+        return {"joints": self.joints, "odom": self.odom, "battery": self.battery}
 
     def pose_estimate(self) -> Pose2D:
         return tf.compose_planar(self._correction, self.odometry())
 
     def is_docked(self) -> bool:
-        raise HardwareUnavailable("docking is not offered over ROS yet (docs/reference/robot-interfaces.md)")
+        state = self.battery.after(self._settled["battery"], READING_TIMEOUT_S)[1]
+        return state.power_supply_status == BatteryState.POWER_SUPPLY_STATUS_CHARGING
 
     def laser_scan(self) -> LaserScan:
         self._subscribe_sensor(LASER, LaserScanMsg, self.scans)
@@ -320,10 +335,20 @@ class RosHardware:
         )
 
     def dock(self) -> Execution:
-        return FailedExecution("dock", "INTERNAL", "docking is not offered over ROS yet")
+        goal = DockRobot.Goal(use_dock_id=True, dock_id=self.dock_id, navigate_to_staging_pose=False)
+        return self._docking("dock", DOCK_ROBOT, self.docking, goal)
 
     def undock(self) -> Execution:
-        return FailedExecution("undock", "INTERNAL", "docking is not offered over ROS yet")
+        return self._docking("undock", UNDOCK_ROBOT, self.undocking, UndockRobot.Goal())
+
+    def _docking(self, name: str, action: str, client: ActionClient, goal: Any) -> Execution:
+        sent = [(action, client, goal)]
+        return self._claim(
+            {"base"},
+            lambda: GoalsExecution(
+                name, sent, self._now_or_zero, DOCKING_S, "MOTION_FAILED", on_end=self._command_ended
+            ),
+        )
 
     # -- for the loops -------------------------------------------------------------------------
     def publish_twist(self, linear: float, angular: float) -> None:

@@ -142,7 +142,7 @@ def main(argv: list[str] | None = None) -> int:
         )
         built.append(sim_node)
         if args.robot_interfaces:  # kept with the node: its action servers live as long
-            sim_node.robot_interfaces = RobotInterfaces(node, sim_thread, navigation)
+            sim_node.robot_interfaces = RobotInterfaces(node, believed, sim_thread, navigation)
         lab_reset = LabReset(node, sim_thread, skills.actions.slot)
         lab_reset.hooks += [sim_node.forget_the_old_lab, skills.forget]
         log.info("sim node ready: world %s, %d stations", world.source, len(world.stations))

@@ -18,7 +18,6 @@ import numpy as np
 import pytest
 import rclpy
 from geometry_msgs.msg import Pose2D as Pose2DMsg
-from labware_interfaces.action import Undock
 from rclpy.executors import MultiThreadedExecutor
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
@@ -47,7 +46,7 @@ def robot(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[RosHardwar
         "5",
     ]
     with running("tiago_twin", *arguments, log_path=log_path):
-        caller = RosCaller("test_ros_hardware_caller")  # the in-process skills' actions (undock)
+        caller = RosCaller("test_ros_hardware_caller")  # reads the simulator's ground truth
         node = rclpy.create_node("test_ros_hardware")
         executor = MultiThreadedExecutor(num_threads=4)
         executor.add_node(node)
@@ -143,12 +142,12 @@ def test_a_laser_scan_covers_the_lasers_field(robot: tuple[RosHardware, RosCalle
     assert len(scan.ranges) > 600 and np.isfinite(scan.ranges).any()
 
 
-def test_the_base_drives_to_an_odometry_pose_and_navigates_to_a_station(
-    robot: tuple[RosHardware, RosCaller],
-) -> None:
+def test_the_base_undocks_drives_navigates_and_docks(robot: tuple[RosHardware, RosCaller]) -> None:
     hardware, caller = robot
-    outcome = caller.call_action(Undock, "/undock", Undock.Goal(), WAIT_S)
-    assert outcome.result.success, outcome.result.message
+    assert hardware.is_docked()
+    undocking = finished(hardware.undock())
+    assert undocking.success, undocking.message
+    assert not hardware.is_docked()
     x, y, yaw = hardware.odometry()
     goal = (x + 0.2 * math.cos(yaw), y + 0.2 * math.sin(yaw), yaw + math.radians(10))
     drive = finished(hardware.drive_to(goal, 0.3))
@@ -166,3 +165,10 @@ def test_the_base_drives_to_an_odometry_pose_and_navigates_to_a_station(
     caller.node.create_subscription(Pose2DMsg, "/ground_truth/base_pose", truth.append, qos)
     caller.wait_for(lambda: bool(truth), 30.0, "the true pose")
     assert math.hypot(truth[-1].x - target.x, truth[-1].y - target.y) < 0.25
+
+    world = load_world(DEFAULT_WORLD)
+    approach = world.pois[world.dock_poi]
+    assert finished(hardware.navigate_to((approach.x, approach.y, approach.yaw), world.dock_poi)).success
+    docking = finished(hardware.dock())
+    assert docking.success, docking.message
+    assert hardware.is_docked()

@@ -1,11 +1,15 @@
-"""The base's ROS 2 interfaces a TIAGo++ offers: its velocity command and Nav2's navigation goal.
+"""The base's ROS 2 interfaces a TIAGo++ offers: its velocity command, Nav2's navigation goal, and the
+docking a lab adds (Nav2's docking server, and the battery state its charging dock reads).
 
 Why: software written against a real robot drives the base by `/mobile_base_controller/cmd_vel_unstamped`
 (geometry_msgs/Twist, as twist_mux forwards it) and navigates by Nav2's `/navigate_to_pose`. The
 simulator offers both (tiago_twin --robot-interfaces): a velocity message drives the base for
 CMD_VEL_TIMEOUT_S of robot time, as diff_drive_controller does, and a message before then renews the
 command without braking; a navigation goal goes to the navigation stand-in (navigation.Navigation),
-the simulator's Nav2.
+the simulator's Nav2. The one dock of the world file answers to any dock id of "" or its POI's
+name; docking drives onto it from where the base stands (or first navigates to its POI, the staging
+pose, when the goal asks), undocking drives off it. `/battery_state` says CHARGING while the
+charging contacts touch the dock, as Nav2's charging dock tells a docked robot.
 
 Threads: subscription and goal callbacks on the node's executor threads; the base moves on the sim
 thread (jobs).
@@ -19,13 +23,15 @@ from typing import Any
 
 from builtin_interfaces.msg import Duration
 from geometry_msgs.msg import Twist
-from nav2_msgs.action import NavigateToPose
+from nav2_msgs.action import DockRobot, NavigateToPose, UndockRobot
 from rclpy.action import ActionServer, CancelResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
+from sensor_msgs.msg import BatteryState
 
-from robot_port.tiago_interfaces import CMD_VEL, NAVIGATE_TO_POSE
+from lab_description.world import World
+from robot_port.tiago_interfaces import BATTERY_STATE, CMD_VEL, DOCK_ROBOT, NAVIGATE_TO_POSE, UNDOCK_ROBOT
 from tiago_sim.sim_node.localisation_topics import stamp_of
 from tiago_sim.sim_node.navigation import Navigation
 from tiago_sim.sim_node.sim_thread import SimThread
@@ -108,3 +114,87 @@ class NavigateToPoseServer:
 def _duration(seconds: float) -> Duration:
     stamp = stamp_of(max(seconds, 0.0))
     return Duration(sec=stamp.sec, nanosec=stamp.nanosec)
+
+
+BATTERY_RATE_HZ = 5.0  # wall
+
+
+class DockingServers:
+    """/dock_robot and /undock_robot on the simulated dock, and /battery_state from its contacts."""
+
+    def __init__(self, node: Node, world: World, navigation: Navigation, sim_thread: SimThread) -> None:
+        self.world = world
+        self.navigation = navigation
+        self.sim_thread = sim_thread
+        group = ReentrantCallbackGroup()
+        cancel = lambda _handle: CancelResponse.ACCEPT  # noqa: E731
+        self.servers = [
+            ActionServer(
+                node, DockRobot, DOCK_ROBOT, self._dock, cancel_callback=cancel, callback_group=group
+            ),
+            ActionServer(
+                node, UndockRobot, UNDOCK_ROBOT, self._undock, cancel_callback=cancel, callback_group=group
+            ),
+        ]
+        reliable = QoSProfile(depth=2, reliability=ReliabilityPolicy.RELIABLE)
+        self.battery = node.create_publisher(BatteryState, BATTERY_STATE, reliable)
+        node.create_timer(1.0 / BATTERY_RATE_HZ, self._publish_battery)
+
+    def _publish_battery(self) -> None:
+        try:
+            sim_time, docked = self.sim_thread.run(lambda sim: (sim.sim_time, sim.is_docked()), 5.0)
+        except Exception:  # noqa: BLE001 - the simulation is stopping
+            return
+        message = BatteryState(present=True, percentage=1.0)
+        message.header.stamp = stamp_of(sim_time)
+        message.power_supply_status = (
+            BatteryState.POWER_SUPPLY_STATUS_CHARGING
+            if docked
+            else BatteryState.POWER_SUPPLY_STATUS_DISCHARGING
+        )
+        self.battery.publish(message)
+
+    def _follow(self, handle: Any, start: Any) -> tuple[bool, str]:
+        """Run a base motion started by `start(sim)` to its end (stopping it on a cancel)."""
+        motion = self.sim_thread.run(start, 60.0)
+        while not motion.finished.wait(FEEDBACK_PERIOD_S):
+            if handle.is_cancel_requested:
+                self.sim_thread.call(lambda _sim: motion.cancel())
+        return bool(motion.success), f"{motion.error_code}: {motion.message}"
+
+    def _dock(self, handle: Any) -> DockRobot.Result:
+        goal, result = handle.request, DockRobot.Result()
+        if goal.use_dock_id and goal.dock_id not in ("", self.world.dock_poi):
+            result.success, result.error_code = False, DockRobot.Result.DOCK_NOT_IN_DB
+            result.error_msg = f"no dock {goal.dock_id!r}: the lab's dock is {self.world.dock_poi!r}"
+            handle.abort()
+            return result
+        if goal.navigate_to_staging_pose:
+            poi = self.world.pois[self.world.dock_poi]
+            staging = self.navigation.navigate(
+                (poi.x, poi.y, poi.yaw), f"the dock POI {self.world.dock_poi!r}"
+            )
+            while not staging.wait(FEEDBACK_PERIOD_S):
+                if handle.is_cancel_requested:
+                    staging.cancel()
+            if not staging.success:
+                result.success, result.error_code = False, DockRobot.Result.FAILED_TO_STAGE
+                result.error_msg = staging.message
+                handle.canceled() if handle.is_cancel_requested else handle.abort()
+                return result
+        docked, why = self._follow(handle, lambda sim: sim.dock())
+        return self._ended(handle, result, docked, why)
+
+    def _undock(self, handle: Any) -> UndockRobot.Result:
+        undocked, why = self._follow(handle, lambda sim: sim.undock())
+        return self._ended(handle, UndockRobot.Result(), undocked, why)
+
+    @staticmethod
+    def _ended(handle: Any, result: Any, success: bool, why: str) -> Any:
+        result.success = success
+        if success:
+            handle.succeed()
+            return result
+        result.error_code, result.error_msg = type(result).FAILED_TO_CONTROL, why
+        handle.canceled() if handle.is_cancel_requested else handle.abort()
+        return result

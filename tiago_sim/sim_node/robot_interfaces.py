@@ -3,15 +3,16 @@
 Why: the skills reach the twin through the hardware port in-process, the fast way campaigns need;
 software written against a real robot (and the port's ROS adapter) speaks the robot's interfaces
 instead (robot_port.tiago_interfaces). These are the ones the sensor topics do not already give:
-the controllers' actions (controllers), the base's velocity input and Nav2's navigation goal
-(base_interfaces). Off by default: their endpoints cost discovery and CPU in every trial.
+the controllers' actions (controllers), the base's velocity input, Nav2's navigation goal and the
+docking a lab adds (base_interfaces). Off by default: their endpoints cost discovery and CPU in every trial.
 """
 
 from __future__ import annotations
 
 from rclpy.node import Node
 
-from tiago_sim.sim_node.base_interfaces import BaseVelocityInput, NavigateToPoseServer
+from lab_description.world import World
+from tiago_sim.sim_node.base_interfaces import BaseVelocityInput, DockingServers, NavigateToPoseServer
 from tiago_sim.sim_node.controllers import TrajectoryControllers
 from tiago_sim.sim_node.navigation import Navigation
 from tiago_sim.sim_node.sim_thread import SimThread
@@ -20,7 +21,8 @@ from tiago_sim.sim_node.sim_thread import SimThread
 class RobotInterfaces:
     """The controllers, the velocity input and the navigation goal, on the sim node's node."""
 
-    def __init__(self, node: Node, sim_thread: SimThread, navigation: Navigation) -> None:
+    def __init__(self, node: Node, world: World, sim_thread: SimThread, navigation: Navigation) -> None:
         self.controllers = TrajectoryControllers(node, sim_thread)
         self.velocity = BaseVelocityInput(node, sim_thread)
         self.navigation = NavigateToPoseServer(node, navigation, sim_thread)
+        self.docking = DockingServers(node, world, navigation, sim_thread)
