@@ -1,6 +1,7 @@
 """Command line entry point `sila-labware`: serve the robot and its stations over SiLA, or run the demo.
 
     sila-labware serve --world FILE [--host H] [--port-base N] [--insecure] [--ca-file PATH] [--pace X]
+        [--ros-adapter]
                        [--print-config json]   (connection details as JSON: deployment/connection_config)
     sila-labware demo  --world FILE [--json] [--record DIR] [--pace X] [stack options as serve]
     sila-labware bench --trials N --seed S [--json] [--report DIR] [--replay SEED] [levels] (bench_cli)
@@ -52,7 +53,12 @@ from sila_labware.deployment.cli_arguments import (
 )
 from sila_labware.deployment.connection_config import add_print_config_argument, print_servers, write_config
 from sila_labware.deployment.json_outcome import JsonOutput, UsageError, outcome_fields
-from sila_labware.deployment.pacing import add_pace_argument, pace_problem
+from sila_labware.deployment.pacing import (
+    ROS_ADAPTER_MAX_PACE,
+    add_pace_argument,
+    add_ros_adapter_argument,
+    pace_problem,
+)
 from sila_labware.deployment.world_file import add_world_command, world_command, world_problems
 from sila_labware.servers.refusal_log import install_refusal_log_filter
 
@@ -87,6 +93,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     add_stack_arguments(serve, DEFAULT_WORLD)
     add_pace_argument(serve)
+    add_ros_adapter_argument(serve)
     add_inventory_arguments(serve)
     add_print_config_argument(serve)
     demo = subcommands.add_parser(
@@ -94,6 +101,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     add_stack_arguments(demo, DEFAULT_WORLD)
     add_pace_argument(demo)
+    add_ros_adapter_argument(demo)
     demo.add_argument(
         "--json", action="store_true", help="print one JSON object with the outcome and timings"
     )
@@ -128,7 +136,10 @@ def _validate(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None
             parser.error(f"--name: {error}")
     if args.domain_id is not None and not 0 <= args.domain_id <= 232:
         parser.error(f"--domain-id {args.domain_id} is outside 0..232")
-    if problem := pace_problem(getattr(args, "pace", None)):
+    pace = getattr(args, "pace", None)
+    if getattr(args, "ros_adapter", False) and pace is not None and pace > ROS_ADAPTER_MAX_PACE:
+        parser.error(f"--ros-adapter runs at --pace {ROS_ADAPTER_MAX_PACE:g} at most, not {pace:g}")
+    if problem := pace_problem(pace):
         parser.error(problem)
     if args.command == "bench":
         validate_bench(parser, args)
@@ -170,7 +181,10 @@ def _deployment_options(args: argparse.Namespace, ca_file: Path) -> DeploymentOp
         domain_id=args.domain_id,
         ready_timeout_s=args.ready_timeout,
         log_dir=args.log_dir,
-        extra_sim_arguments=[] if record is None else ["--record-dir", str(record / "frames")],
+        extra_sim_arguments=[
+            *([] if record is None else ["--record-dir", str(record / "frames")]),
+            *(["--ros-adapter"] if getattr(args, "ros_adapter", False) else []),
+        ],
         lab_name=args.name,
         pace=getattr(args, "pace", None),
         inventory_file=getattr(args, "inventory", None),

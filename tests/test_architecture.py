@@ -80,6 +80,7 @@ ALLOWED: dict[str, set[str]] = {
     # the start-up: the one unit that imports both the simulator and the skills
     "tiago_twin": {
         "robot_port",
+        "tiago_ros_hardware",
         *DESCRIPTIONS,
         "tiago_skills",
         "tiago_skills.perception",

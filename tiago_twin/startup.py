@@ -1,7 +1,7 @@
 """Start the digital twin: the simulated TIAGo++ and the robot's skills on one ROS 2 node.
 
     python -m tiago_twin --world FILE [--seed N] [--realtime-factor-cap X]
-        [--idle-realtime-factor X] [--disturbance-seed N] [--robot-interfaces] ...
+        [--idle-realtime-factor X] [--disturbance-seed N] [--robot-interfaces | --ros-adapter] ...
 
 Why one module: it is the one place that knows both sides. The simulator (tiago_sim.sim_node)
 plays the hardware and the vendor's stack and offers the hardware port; the skills
@@ -25,6 +25,7 @@ from rclpy.node import Node
 
 from lab_description.world import DEFAULT_WORLD, World, WorldError, load_world
 from tiago_description.motion_library import DEFAULT_MOTIONS_FILE
+from tiago_ros_hardware.hardware import RosHardware
 from tiago_sim.measuring.run_recorder import RunRecorder
 from tiago_sim.node_main import spin_node
 from tiago_sim.sim_node.hardware import SimulatedHardware
@@ -39,6 +40,10 @@ from tiago_twin.lab_reset import LabReset
 log = logging.getLogger("tiago_twin")
 
 INVALID_WORLD_EXIT_CODE = 2
+ADAPTER_PACE = 5.0
+ADAPTER_MAX_PACE = 10.0
+"""The adapter renews velocity commands every 0.05 s of wall time and a command lapses after 0.5 s
+of robot time (tiago_ros_hardware.base_loops): the robot may run at most ten times the wall."""
 """Exit code for a world file that does not validate; the reason is the last line on stderr."""
 
 
@@ -83,13 +88,26 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         help="also serve a TIAGo++'s own ROS 2 interfaces (the controllers' FollowJointTrajectory, "
         "the base's velocity command, Nav2's navigate_to_pose), for software written against a robot",
     )
+    parser.add_argument(
+        "--ros-adapter",
+        action="store_true",
+        help="the skills reach the simulated robot through its own ROS 2 interfaces (tiago_ros_hardware), "
+        f"as they would a real TIAGo++; serves them, and paces motion at {ADAPTER_PACE:g} times real time "
+        f"at most unless --realtime-factor-cap says otherwise (at most {ADAPTER_MAX_PACE:g})",
+    )
     parser.add_argument("--log-level", default="INFO")
     parser.add_argument(
         "--near-misses",
         action="store_true",
         help="log robot parts passing within 1 cm of the lab (measuring)",
     )
-    return parser.parse_args(argv)
+    args = parser.parse_args(argv)
+    if args.ros_adapter:
+        args.robot_interfaces = True
+        args.realtime_factor_cap = args.realtime_factor_cap or ADAPTER_PACE
+        if args.realtime_factor_cap > ADAPTER_MAX_PACE:
+            parser.error(f"--ros-adapter needs --realtime-factor-cap at most {ADAPTER_MAX_PACE:g}")
+    return args
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -123,10 +141,13 @@ def main(argv: list[str] | None = None) -> int:
         sim_thread.start()
         believed = robot_world(world, args)
         navigation = Navigation(node, believed, sim_thread)
+        hardware = RosHardware(node) if args.ros_adapter else SimulatedHardware(sim_thread, navigation)
+        if args.ros_adapter:
+            log.info("the skills reach the robot through its own ROS 2 interfaces (tiago_ros_hardware)")
         skills = RobotSkills(
             node,
             believed,
-            SimulatedHardware(sim_thread, navigation),
+            hardware,
             args.motions,
             seed=args.seed if args.seed is not None else args.disturbance_seed,
             motion_time=lambda: sim_thread.busy_sim_s,
@@ -152,7 +173,12 @@ def main(argv: list[str] | None = None) -> int:
         sim_thread.stop()
         for sim_node in built:  # what localisation cost the sim thread, beside its own figures
             sim_node.localisation.log_cost()
+            if sim_node.robot_interfaces is not None:
+                sim_node.robot_interfaces.log_use()
 
+    # Over the adapter, a skill's goal waits on controller goals and readings served by this same
+    # node: each waiting goal holds a thread.
+    threads = 16 if args.ros_adapter else 8
     return spin_node(
-        "tiago_sim", lambda: MultiThreadedExecutor(num_threads=8), build, before_shutdown=shut_down
+        "tiago_sim", lambda: MultiThreadedExecutor(num_threads=threads), build, before_shutdown=shut_down
     )

@@ -26,6 +26,21 @@ def add_pace_argument(parser: argparse.ArgumentParser) -> None:
     )
 
 
+ROS_ADAPTER_MAX_PACE = 10.0
+"""Over the robot's own interfaces the skills renew velocity commands on the wall clock, and each
+lapses after 0.5 s of robot time (tiago_ros_hardware.base_loops): at most ten times real time."""
+
+
+def add_ros_adapter_argument(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--ros-adapter",
+        action="store_true",
+        help="the skills reach the simulated robot through a TIAGo++'s own ROS 2 interfaces, as they "
+        "would a real one (paced at 5 times real time unless --pace says otherwise, "
+        f"at most {ROS_ADAPTER_MAX_PACE:g})",
+    )
+
+
 def pace_problem(pace: float | None) -> str | None:
     """Why `pace` is no usable pace (None: it is, or none was asked for)."""
     if pace is None:

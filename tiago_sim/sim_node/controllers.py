@@ -82,6 +82,7 @@ class TrajectoryControllers:
         self.sim_thread = sim_thread
         self._lock = threading.Lock()
         self._running: dict[str, tuple[Any, Any]] = {}  # group -> (goal handle, motion)
+        self.goals = dict.fromkeys(JOINT_GROUPS, 0)  # goals run, per controller
         group = ReentrantCallbackGroup()
         self.servers = [
             ActionServer(
@@ -117,6 +118,7 @@ class TrajectoryControllers:
         return motion
 
     def _execute(self, group: str, handle: Any) -> FollowJointTrajectory.Result:
+        self.goals[group] += 1
         trajectory = handle.request.trajectory
         names = list(trajectory.joint_names)
         times = [_seconds(point) for point in trajectory.points]

@@ -9,6 +9,8 @@ docking a lab adds (base_interfaces). Off by default: their endpoints cost disco
 
 from __future__ import annotations
 
+import logging
+
 from rclpy.node import Node
 
 from lab_description.world import World
@@ -16,6 +18,8 @@ from tiago_sim.sim_node.base_interfaces import BaseVelocityInput, DockingServers
 from tiago_sim.sim_node.controllers import TrajectoryControllers
 from tiago_sim.sim_node.navigation import Navigation
 from tiago_sim.sim_node.sim_thread import SimThread
+
+log = logging.getLogger(__name__)
 
 
 class RobotInterfaces:
@@ -26,3 +30,8 @@ class RobotInterfaces:
         self.velocity = BaseVelocityInput(node, sim_thread)
         self.navigation = NavigateToPoseServer(node, navigation, sim_thread)
         self.docking = DockingServers(node, world, navigation, sim_thread)
+
+    def log_use(self) -> None:
+        """How many goals each controller ran (a run's summary, on the way out)."""
+        counts = ", ".join(f"{group} {count}" for group, count in self.controllers.goals.items() if count)
+        log.info("the robot's own interfaces: controller goals: %s", counts or "none")
