@@ -23,6 +23,8 @@ from __future__ import annotations
 
 import math
 import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import Any
 
 import numpy as np
@@ -106,7 +108,6 @@ class RosHardware:
         self._subscribe(Odometry, ODOMETRY, self._on_odometry, reliable)
         self._subscribe(TransformStamped, CORRECTION_TOPIC, self._on_correction, latched)
         self._subscribe(BatteryState, BATTERY_STATE, self.battery.add, reliable)
-        self._sensors_subscribed: set[str] = set()
         self._settled = {"joints": 0, "odom": 0, "battery": 0}  # counts after which readings show it at rest
         self.cmd_vel = node.create_publisher(Twist, CMD_VEL, reliable)
         self.controllers = {
@@ -176,9 +177,9 @@ class RosHardware:
         return state.power_supply_status == BatteryState.POWER_SUPPLY_STATUS_CHARGING
 
     def laser_scan(self) -> LaserScan:
-        self._subscribe_sensor(LASER, LaserScanMsg, self.scans)
         settled, _odometry = self.odom.after(self._settled["odom"], READING_TIMEOUT_S)
-        stamp, message = self.scans.newer_than(settled - 1e-9, READING_TIMEOUT_S)
+        with self._listening((LASER, LaserScanMsg, self.scans)):
+            stamp, message = self.scans.newer_than(settled - 1e-9, READING_TIMEOUT_S)
         odometry = self.odom.at(stamp)
         ranges = np.array(message.ranges, dtype=float)
         ranges[~np.isfinite(ranges) | (ranges > message.range_max)] = np.inf
@@ -194,16 +195,14 @@ class RosHardware:
         )
 
     def capture_head_camera(self) -> CameraFrame:
-        for topic, kind, history in (
+        settled, _joints = self.joints.after(self._settled["joints"], READING_TIMEOUT_S)
+        with self._listening(
             (CAMERA_IMAGE, Image, self.images),
             (CAMERA_DEPTH, Image, self.depths),
             (CAMERA_INFO, CameraInfo, self.infos),
         ):
-            self._subscribe_sensor(topic, kind, history)
-        settled, _joints = self.joints.after(self._settled["joints"], READING_TIMEOUT_S)
-        stamp, image = self.images.newer_than(settled - 1e-9, READING_TIMEOUT_S)  # rendered since
-        _, depth = self.depths.newer_than(stamp - 1e-9, READING_TIMEOUT_S)
-        _, info = self.infos.newer_than(stamp - 1e-9, READING_TIMEOUT_S)
+            stamp, image, depth = self._frame_pair(settled)
+            _, info = self.infos.newer_than(stamp - 1e-9, READING_TIMEOUT_S)  # the same intrinsics always
         rgb = np.frombuffer(bytes(image.data), dtype=np.uint8).reshape(image.height, image.width, 3)
         metres = np.frombuffer(bytes(depth.data), dtype=np.float32).reshape(depth.height, depth.width)
         k = info.k
@@ -221,13 +220,30 @@ class RosHardware:
             stamp,
         )
 
-    def _subscribe_sensor(self, topic: str, kind: Any, history: TopicHistory) -> None:
-        """Subscribe on first use: the camera renders and the laser scans only while someone listens."""
-        with self._lock:
-            if topic in self._sensors_subscribed:
-                return
-            self._sensors_subscribed.add(topic)
-        self._subscribe(kind, topic, history.add, QoSProfile(depth=2, reliability=ReliabilityPolicy.RELIABLE))
+    def _frame_pair(self, since_s: float) -> tuple[float, Any, Any]:
+        """A colour image rendered after `since_s` and the depth image of the same stamp (the two
+        topics' first messages may arrive for different frames)."""
+        while True:
+            stamp, image = self.images.newer_than(since_s - 1e-9, READING_TIMEOUT_S)
+            depth_stamp, depth = self.depths.newer_than(stamp - 1e-9, READING_TIMEOUT_S)
+            if abs(depth_stamp - stamp) < 1e-6:
+                return stamp, image, depth
+            since_s = depth_stamp  # the depth is of a later frame: take that frame's pair
+
+    @contextmanager
+    def _listening(self, *topics: tuple[str, Any, TopicHistory]) -> Iterator[None]:
+        """Subscribed to `topics` for the block only: a simulator renders its camera and casts its
+        laser only while someone listens, and a robot's images are heavy on the network."""
+        qos = QoSProfile(depth=2, reliability=ReliabilityPolicy.RELIABLE)
+        subscriptions = [
+            self.node.create_subscription(kind, topic, history.add, qos, callback_group=self._group)
+            for topic, kind, history in topics
+        ]
+        try:
+            yield
+        finally:
+            for subscription in subscriptions:
+                self.node.destroy_subscription(subscription)
 
     # -- commands ------------------------------------------------------------------------------
     def _claim(self, groups: set[str], execution: Any) -> Execution:
