@@ -53,12 +53,7 @@ from sila_labware.deployment.cli_arguments import (
 )
 from sila_labware.deployment.connection_config import add_print_config_argument, print_servers, write_config
 from sila_labware.deployment.json_outcome import JsonOutput, UsageError, outcome_fields
-from sila_labware.deployment.pacing import (
-    ROS_ADAPTER_MAX_PACE,
-    add_pace_argument,
-    add_ros_adapter_argument,
-    pace_problem,
-)
+from sila_labware.deployment.pacing import add_pace_argument, add_ros_adapter_argument, pace_problem
 from sila_labware.deployment.world_file import add_world_command, world_command, world_problems
 from sila_labware.servers.refusal_log import install_refusal_log_filter
 
@@ -136,10 +131,7 @@ def _validate(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None
             parser.error(f"--name: {error}")
     if args.domain_id is not None and not 0 <= args.domain_id <= 232:
         parser.error(f"--domain-id {args.domain_id} is outside 0..232")
-    pace = getattr(args, "pace", None)
-    if getattr(args, "ros_adapter", False) and pace is not None and pace > ROS_ADAPTER_MAX_PACE:
-        parser.error(f"--ros-adapter runs at --pace {ROS_ADAPTER_MAX_PACE:g} at most, not {pace:g}")
-    if problem := pace_problem(pace):
+    if problem := pace_problem(getattr(args, "pace", None), getattr(args, "ros_adapter", False)):
         parser.error(problem)
     if args.command == "bench":
         validate_bench(parser, args)

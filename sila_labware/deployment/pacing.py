@@ -41,10 +41,12 @@ def add_ros_adapter_argument(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def pace_problem(pace: float | None) -> str | None:
+def pace_problem(pace: float | None, ros_adapter: bool = False) -> str | None:
     """Why `pace` is no usable pace (None: it is, or none was asked for)."""
     if pace is None:
         return None
+    if ros_adapter and pace > ROS_ADAPTER_MAX_PACE:
+        return f"--ros-adapter runs at --pace {ROS_ADAPTER_MAX_PACE:g} at most, not {pace:g}"
     if not 0.0 < pace <= MAX_PACE:  # also refuses nan
         return f"--pace {pace:g} is outside 0 < X <= {MAX_PACE:g}"
     return None

@@ -80,3 +80,11 @@ def test_serve_print_config_json_lists_what_a_client_connects_to(tmp_path: Path)
         if serve.poll() is None:
             serve.kill()
             serve.wait()
+
+
+def test_the_ros_adapter_refuses_a_pace_its_velocity_commands_cannot_keep() -> None:
+    from sila_labware.deployment.pacing import pace_problem
+
+    assert pace_problem(10.0, ros_adapter=True) is None
+    assert "at most" in (pace_problem(20.0, ros_adapter=True) or "")
+    assert pace_problem(20.0) is None

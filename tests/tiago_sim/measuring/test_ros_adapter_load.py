@@ -7,7 +7,7 @@ from action_msgs.msg import GoalStatusArray
 from control_msgs.action import FollowJointTrajectory
 from sensor_msgs.msg import JointState
 
-from sila_labware.benchmarks.ros_adapter_load import _message_type
+from tiago_sim.measuring.ros_adapter_load import _message_type
 
 
 def test_a_topic_type_names_its_message_class() -> None:
