@@ -83,9 +83,12 @@ def yaw_of(orientation: Any) -> float:
 class RosHardware:
     """robot_port.RobotHardware on the robot's ROS 2 interfaces, through `node`."""
 
-    def __init__(self, node: Node, dock_id: str = "") -> None:
+    def __init__(self, node: Node, dock_id: str = "", simulated_clock: bool = True) -> None:
+        """`simulated_clock`: the robot's time is a simulator's `/clock`; a robot's is the node's
+        own clock (wall time)."""
         self.node = node
         self.dock_id = dock_id
+        self.simulated_clock = simulated_clock
         self._group = ReentrantCallbackGroup()
         self._lock = threading.Lock()
         self._busy: dict[str, Execution] = {}
@@ -145,12 +148,16 @@ class RosHardware:
 
     # -- clock and readings --------------------------------------------------------------------
     def now(self) -> float:
+        if not self.simulated_clock:
+            return self.node.get_clock().now().nanoseconds * 1e-9
         with self._clock_changed:
             if not self._clock_changed.wait_for(lambda: self._clock_s is not None, READING_TIMEOUT_S):
                 raise HardwareUnavailable("no /clock from the robot")
             return float(self._clock_s)
 
     def _now_or_zero(self) -> float:
+        if not self.simulated_clock:
+            return self.now()
         return float(self._clock_s or 0.0)
 
     def joint_positions(self) -> dict[str, float]:
