@@ -25,13 +25,11 @@ from rclpy.node import Node
 
 from lab_description.world import DEFAULT_WORLD, World, WorldError, load_world
 from tiago_description.motion_library import DEFAULT_MOTIONS_FILE
-from tiago_ros_hardware.hardware import RosHardware
 from tiago_sim.measuring.run_recorder import RunRecorder
 from tiago_sim.node_main import spin_node
 from tiago_sim.sim_node.hardware import SimulatedHardware
 from tiago_sim.sim_node.navigation import Navigation
 from tiago_sim.sim_node.node import SimNode, make_simulation, robot_world
-from tiago_sim.sim_node.robot_interfaces import RobotInterfaces
 from tiago_sim.sim_node.sim_thread import SimThread
 from tiago_skills.perception.aruco import detect_marker, draw_detection
 from tiago_skills.skills_node import RobotSkills
@@ -141,8 +139,11 @@ def main(argv: list[str] | None = None) -> int:
         sim_thread.start()
         believed = robot_world(world, args)
         navigation = Navigation(node, believed, sim_thread)
-        hardware = RosHardware(node) if args.ros_adapter else SimulatedHardware(sim_thread, navigation)
-        if args.ros_adapter:
+        hardware: Any = SimulatedHardware(sim_thread, navigation)
+        if args.ros_adapter:  # imported here: the robot's interface packages are built by ./run only
+            from tiago_ros_hardware.hardware import RosHardware
+
+            hardware = RosHardware(node)
             log.info("the skills reach the robot through its own ROS 2 interfaces (tiago_ros_hardware)")
         skills = RobotSkills(
             node,
@@ -163,6 +164,8 @@ def main(argv: list[str] | None = None) -> int:
         )
         built.append(sim_node)
         if args.robot_interfaces:  # kept with the node: its action servers live as long
+            from tiago_sim.sim_node.robot_interfaces import RobotInterfaces
+
             sim_node.robot_interfaces = RobotInterfaces(node, believed, sim_thread, navigation)
         lab_reset = LabReset(node, sim_thread, skills.actions.slot)
         lab_reset.hooks += [sim_node.forget_the_old_lab, skills.forget]
