@@ -32,6 +32,7 @@ from sensor_msgs.msg import BatteryState
 
 from lab_description.world import World
 from robot_port.tiago_interfaces import BATTERY_STATE, CMD_VEL, DOCK_ROBOT, NAVIGATE_TO_POSE, UNDOCK_ROBOT
+from tiago_sim.sim_node.hardware import MotionExecution
 from tiago_sim.sim_node.localisation_topics import stamp_of
 from tiago_sim.sim_node.navigation import Navigation
 from tiago_sim.sim_node.sim_thread import SimThread
@@ -41,6 +42,16 @@ log = logging.getLogger(__name__)
 CMD_VEL_TIMEOUT_S = 0.5
 """Robot seconds a velocity command lasts without a new one (diff_drive_controller's default)."""
 FEEDBACK_PERIOD_S = 0.2
+
+
+def follow(handle: Any, execution: Any, each_period: Any = None) -> None:
+    """Wait for `execution` (the port's Execution) to end, cancelling it when the goal `handle` is
+    cancelled and calling `each_period` (feedback) between waits."""
+    while not execution.wait(FEEDBACK_PERIOD_S):
+        if handle.is_cancel_requested:
+            execution.cancel()
+        if each_period is not None:
+            each_period()
 
 
 class BaseVelocityInput:
@@ -92,13 +103,14 @@ class NavigateToPoseServer:
         goal = (float(pose.position.x), float(pose.position.y), yaw)
         started = self.sim_thread.sim_time
         execution = self.navigation.navigate(goal, f"({goal[0]:.2f}, {goal[1]:.2f})")
-        while not execution.wait(FEEDBACK_PERIOD_S):
-            if handle.is_cancel_requested:
-                execution.cancel()
-            feedback = NavigateToPose.Feedback()
-            feedback.navigation_time = _duration(self.sim_thread.sim_time - started)
-            feedback.estimated_time_remaining = _duration(execution.remaining_s)
-            handle.publish_feedback(feedback)
+
+        def feedback() -> None:
+            message = NavigateToPose.Feedback()
+            message.navigation_time = _duration(self.sim_thread.sim_time - started)
+            message.estimated_time_remaining = _duration(execution.remaining_s)
+            handle.publish_feedback(message)
+
+        follow(handle, execution, feedback)
         if execution.success:
             handle.succeed()
         elif handle.is_cancel_requested:
@@ -156,11 +168,9 @@ class DockingServers:
 
     def _follow(self, handle: Any, start: Any) -> tuple[bool, str]:
         """Run a base motion started by `start(sim)` to its end (stopping it on a cancel)."""
-        motion = self.sim_thread.run(start, 60.0)
-        while not motion.finished.wait(FEEDBACK_PERIOD_S):
-            if handle.is_cancel_requested:
-                self.sim_thread.call(lambda _sim: motion.cancel())
-        return bool(motion.success), f"{motion.error_code}: {motion.message}"
+        execution = MotionExecution(self.sim_thread.run(start, 60.0), self.sim_thread)
+        follow(handle, execution)
+        return execution.success, f"{execution.error_code}: {execution.message}"
 
     def _dock(self, handle: Any) -> DockRobot.Result:
         goal, result = handle.request, DockRobot.Result()
@@ -174,9 +184,7 @@ class DockingServers:
             staging = self.navigation.navigate(
                 (poi.x, poi.y, poi.yaw), f"the dock POI {self.world.dock_poi!r}"
             )
-            while not staging.wait(FEEDBACK_PERIOD_S):
-                if handle.is_cancel_requested:
-                    staging.cancel()
+            follow(handle, staging)
             if not staging.success:
                 result.success, result.error_code = False, DockRobot.Result.FAILED_TO_STAGE
                 result.error_msg = staging.message
