@@ -15,6 +15,7 @@ the nest floor centre where the plate's bottom centre rests (x along the plate's
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -36,7 +37,7 @@ from lab_description.world_rules import check
 from lab_description.world_schema import MARKER_DICTIONARY_SIZE, MIRROR_AMBIGUOUS_MARKER_IDS
 from labware_model.holders import HotelSlot, Nest
 from labware_model.labware import LabwareType, Plate
-from labware_model.workcell import StationDescription, WorkcellDescription
+from labware_model.workcell import STOCK_SENSORS, LabSensors, StationDescription, WorkcellDescription
 from tiago_description import transforms as tf
 
 __all__ = [
@@ -195,6 +196,8 @@ class World:
     """The lab's name (optional in the file): the SiLA servers carry it in their names."""
     obstacles: tuple[Obstacle, ...] = ()
     """Free-standing boxes and cylinders on the floor (world_obstacles)."""
+    sensors: LabSensors = LabSensors()
+    """Lab-added plate sensors the robot's checks may read (a stock TIAGo++ has none)."""
 
     def station(self, name: str) -> Station:
         for station in self.stations:
@@ -209,7 +212,13 @@ class World:
             hotel_slots=self.hotel_slots,
             pois=tuple(sorted(self.pois)),
             dock_poi=self.dock_poi,
+            sensors=self.sensors,
         )
+
+
+def with_stock_sensors(world: World) -> World:
+    """The lab as a stock TIAGo++ meets it: none of the lab-added plate sensors."""
+    return dataclasses.replace(world, sensors=STOCK_SENSORS)
 
 
 def load_world(path: str | Path = DEFAULT_WORLD, *, check_robot: bool = True) -> World:
@@ -377,4 +386,5 @@ def _world(model: schema.WorldFile, source: str, default_name: str, place: Any) 
         model.floor_size,
         name=model.name or default_name,
         obstacles=tuple(_obstacle(item) for item in model.obstacles),
+        sensors=LabSensors(model.sensors.nests, model.sensors.hotel, model.sensors.label_readers),
     )

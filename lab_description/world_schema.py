@@ -85,6 +85,17 @@ class Robot(_Strict):
     )
 
 
+class Sensors(_Strict):
+    """Plate sensors the lab has added. A stock TIAGo++ has none: without them the robot checks a
+    nest with its head camera and its hotel with the fingers' gap, and goals name the plates."""
+
+    nests: bool = Field(True, description="a presence sensor in every nest (published on /station_states)")
+    hotel: bool = Field(True, description="a presence sensor in every onboard hotel pocket")
+    label_readers: bool = Field(
+        True, description="barcode readers at every nest and pocket and in the gripper's palm"
+    )
+
+
 class LabwareType(_Strict):
     """A plate type: its outer box and mass (the plate's frame: x along the long side, z up)."""
 
@@ -261,6 +272,9 @@ class WorldFile(_Strict):
         description="extra named floor poses: name -> [x, y, yaw_deg], world frame (m, m, degrees)",
     )
     robot: Robot
+    sensors: Sensors = Field(
+        default_factory=Sensors, description="lab-added plate sensors (default: all present)"
+    )
     labware_types: dict[str, LabwareType] = Field(description="plate types by name")
     stations: list[Station] = Field(min_length=1, description="one entry per station, any number")
     plates: list[PlateStart] = Field(

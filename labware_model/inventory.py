@@ -133,12 +133,20 @@ class LabwareBook:
         self._records[name] = replace(record, location=location)
         return True
 
-    def settle(self, name: str, candidates: Sequence[Location], sensed: Sequence[SensedPlate]) -> bool:
+    def settle(
+        self,
+        name: str,
+        candidates: Sequence[Location],
+        sensed: Sequence[SensedPlate],
+        unsensed: Location | None = None,
+    ) -> bool:
         """After a transfer: the named plate is on the first of `candidates` (the transfer's
-        destination, the gripper, its source) whose sensor sees a plate, else unknown. True if
-        that changed anything."""
+        destination, the gripper, its source) whose sensor sees a plate; else at `unsensed`, a
+        holder with no sensor where the transfer's checked steps put it; else unknown. True if that
+        changed anything."""
         occupied = {plate.holder for plate in sensed}
-        return self.move(name, next((holder for holder in candidates if holder in occupied), UNKNOWN))
+        found = next((holder for holder in candidates if holder in occupied), unsensed)
+        return self.move(name, found if found is not None else UNKNOWN)
 
     def reconcile(self, sensed: Sequence[SensedPlate], sensed_holders: Collection[Location]) -> bool:
         """Follow the sensors between transfers (see the module's rules). `sensed_holders`: every

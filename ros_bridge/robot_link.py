@@ -27,7 +27,7 @@ from labware_interfaces.srv import CheckPlacement, DescribeWorkcell
 from labware_model.holders import UNKNOWN, HotelSlot, Nest, parse_location
 from labware_model.inventory import LabwareRecord
 from labware_model.readings import HotelSlotReading, NestReading, PlacementCheck
-from labware_model.workcell import StationDescription, WorkcellDescription
+from labware_model.workcell import WorkcellDescription
 from ros_bridge.actions import ActionCaller, ActionGoal, GoalProgress
 from ros_bridge.errors import BridgeError
 from ros_bridge.runtime import RosRuntime
@@ -198,15 +198,8 @@ class RobotLink:
     # --- services ---
 
     def describe_workcell(self, timeout_s: float = 5.0) -> WorkcellDescription:
-        response = self._ros.describe.call(DescribeWorkcell.Request(), timeout_s)
-        return WorkcellDescription(
-            stations=tuple(
-                StationDescription(station.name, int(station.sub_positions), station.poi)
-                for station in response.stations
-            ),
-            hotel_slots=int(response.hotel_slots),
-            pois=tuple(response.pois),
-            dock_poi=response.dock_poi,
+        return WorkcellDescription.from_message(
+            self._ros.describe.call(DescribeWorkcell.Request(), timeout_s)
         )
 
     def check_placement(

@@ -45,7 +45,7 @@ from sila_labware.benchmarks.campaign_cli import (
     validate_bench,
     write_recorded_pictures,
 )
-from sila_labware.deployment import json_outcome
+from sila_labware.deployment import json_outcome, pacing
 from sila_labware.deployment.cli_arguments import (
     add_inventory_arguments,
     add_robot_side_arguments,
@@ -53,7 +53,6 @@ from sila_labware.deployment.cli_arguments import (
 )
 from sila_labware.deployment.connection_config import add_print_config_argument, print_servers, write_config
 from sila_labware.deployment.json_outcome import JsonOutput, UsageError, outcome_fields
-from sila_labware.deployment.pacing import add_pace_argument, add_ros_adapter_argument, pace_problem
 from sila_labware.deployment.world_file import add_world_command, world_command, world_problems
 from sila_labware.servers.refusal_log import install_refusal_log_filter
 
@@ -87,16 +86,14 @@ def build_parser() -> argparse.ArgumentParser:
         "serve", help="run the simulated robot and serve it and its stations over SiLA"
     )
     add_stack_arguments(serve, DEFAULT_WORLD)
-    add_pace_argument(serve)
-    add_ros_adapter_argument(serve)
+    pacing.add_robot_arguments(serve)
     add_inventory_arguments(serve)
     add_print_config_argument(serve)
     demo = subcommands.add_parser(
         "demo", help="serve, then move the plate from the first station to the second"
     )
     add_stack_arguments(demo, DEFAULT_WORLD)
-    add_pace_argument(demo)
-    add_ros_adapter_argument(demo)
+    pacing.add_robot_arguments(demo)
     demo.add_argument(
         "--json", action="store_true", help="print one JSON object with the outcome and timings"
     )
@@ -131,7 +128,7 @@ def _validate(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None
             parser.error(f"--name: {error}")
     if args.domain_id is not None and not 0 <= args.domain_id <= 232:
         parser.error(f"--domain-id {args.domain_id} is outside 0..232")
-    if problem := pace_problem(getattr(args, "pace", None), getattr(args, "ros_adapter", False)):
+    if problem := pacing.pace_problem(getattr(args, "pace", None), getattr(args, "ros_adapter", False)):
         parser.error(problem)
     if args.command == "bench":
         validate_bench(parser, args)
@@ -176,6 +173,7 @@ def _deployment_options(args: argparse.Namespace, ca_file: Path) -> DeploymentOp
         extra_sim_arguments=[
             *([] if record is None else ["--record-dir", str(record / "frames")]),
             *(["--ros-adapter"] if getattr(args, "ros_adapter", False) else []),
+            *(["--stock-sensors"] if getattr(args, "stock_sensors", False) else []),
         ],
         lab_name=args.name,
         pace=getattr(args, "pace", None),

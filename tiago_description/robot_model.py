@@ -25,6 +25,7 @@ import hashlib
 import math
 import os
 import tempfile
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -51,6 +52,22 @@ LASER_MOUNT = (0.202, 0.0, 0.0)
 """The base laser's frame (base_laser_link) in base_footprint: x, y (m) and yaw (rad)."""
 FINGER_TRAVEL = 0.045
 FINGER_MOUNT_OFFSET = 0.005  # inner pad face at this distance from centre when a finger joint is 0
+# Fingers closed on nothing stop with their pads 2 * FINGER_MOUNT_OFFSET apart; closed further apart
+# than this, they hold something. The one "holding" rule of a real gripper (its joint states), for
+# the ROS adapter, the simulator's reports and the grasp's result alike.
+HOLDING_GAP_M = 2 * FINGER_MOUNT_OFFSET + 0.002
+
+
+def finger_gap(finger_positions: Iterable[float]) -> float:
+    """The gap between the pads (m) for the two finger joints' positions."""
+    return 2 * FINGER_MOUNT_OFFSET + sum(finger_positions)
+
+
+def holds_by_gap(closed: bool, finger_positions: Iterable[float]) -> bool:
+    """Whether a gripper commanded closed holds something, from its fingers' positions alone."""
+    return closed and finger_gap(finger_positions) > HOLDING_GAP_M
+
+
 FINGER_SPEED = 0.05
 FINGER_EFFORT = 16.0
 PAD_THICKNESS = 0.010

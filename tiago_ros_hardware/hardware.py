@@ -71,8 +71,6 @@ READING_TIMEOUT_S = 30.0
 CORRECTION_TOPIC = "/map_to_odom"
 NAVIGATION_SPEED_MPS = 0.5  # for the time-left estimate of a navigation goal only
 DOCKING_S = 8.0  # for the time-left estimate of docking and undocking only
-HOLDING_GAP_M = 2 * rm.FINGER_MOUNT_OFFSET + 0.002
-"""Fingers that stop closing with their pads further apart than this hold something."""
 
 
 def yaw_of(orientation: Any) -> float:
@@ -297,9 +295,8 @@ class RosHardware:
         goal.trajectory.points.append(point)
 
         def reading() -> dict[str, Any]:
-            joints = self.joint_positions()
-            opening = 2 * rm.FINGER_MOUNT_OFFSET + sum(joints[name] for name in fingers)
-            return {"holding": bool(close and opening > HOLDING_GAP_M), "opening_m": opening}
+            positions = [self.joint_positions()[name] for name in fingers]
+            return {"holding": rm.holds_by_gap(close, positions), "opening_m": rm.finger_gap(positions)}
 
         sent = [(controller_action(group), self.controllers[group], goal)]
         name = f"gripper_{side}_{'close' if close else 'open'}"

@@ -44,7 +44,9 @@ def planar(transform: np.ndarray) -> tuple[float, float, float]:
     return float(transform[0, 3]), float(transform[1, 3]), math.atan2(transform[1, 0], transform[0, 0])
 
 
-def _search(run: GoalRun, kinematics: RobotKinematics, target: np.ndarray, look: Any, lifting: Any) -> Any:
+def search_marker(
+    run: GoalRun, kinematics: RobotKinematics, target: np.ndarray, look: Any, lifting: Any
+) -> Any:
     """Point the head where the marker should be and look; if it is not in the image, pan left and
     right and look again (odometry drifts over a long drive: a robot has arrived 18 cm and 5 deg
     off its belief). Every extra look is logged; MARKER_NOT_FOUND only when all of them fail.
@@ -111,7 +113,7 @@ def align_base(
     lifting = run.read(move_joints(torso)) if torso else None
     background: list[Execution | None] = [lifting]  # motions running beside the ones this goal follows
     try:
-        sighting = _search(run, kinematics, T_base_marker_expected[:3, 3], look, lifting)
+        sighting = search_marker(run, kinematics, T_base_marker_expected[:3, 3], look, lifting)
         T_marker_work = tf.invert(station.T_world_marker()) @ T_world_work
         correction = planar(sighting.T_base_marker @ T_marker_work)  # working pose in base_footprint
         # The goal is fixed in the odometry frame (where the base stood at the sighting): the
@@ -135,7 +137,7 @@ def align_base(
         # MARKER_NOT_FOUND with nothing disturbed.
         T_marker_at_work = tf.invert(tf.from_planar(*correction)) @ sighting.T_base_marker
         # from the working pose: later tool moves reuse this sighting while the base stands
-        return _search(run, kinematics, T_marker_at_work[:3, 3], look, None)
+        return search_marker(run, kinematics, T_marker_at_work[:3, 3], look, None)
     except BaseException:
         # A cancel or a failure stops the torso and the head too: the robot reported standing
         # still while its torso rose on (a cancel during the search, at 1x real time).

@@ -6,7 +6,9 @@ perception.detect_marker on the rendered image; the camera pose in base_footprin
 kinematics of the joint readings taken with the image; never from simulator link states.
 
 Target "work_pose" moves the base instead (tiago_skills.base_alignment): from the station's POI to
-the working pose in front of the nests, as the marker shows it.
+the working pose in front of the nests, as the marker shows it. Target "inspect" moves nothing but
+the head: it reads from the depth image whether a plate lies in the nest
+(perception.nest_occupancy), the check of a lab whose nests have no sensors.
 
 Steps: take an image (the hardware port) -> detect the marker (this thread) -> T_base_marker =
 T_base_optical @ T_optical_marker -> the nest frame from the world's site_in_marker, sub-position
@@ -32,24 +34,26 @@ from labware_interfaces.msg import ErrorCodes
 
 from lab_description.world import World
 from tiago_description import transforms as tf
-from tiago_description.kinematics import RobotKinematics
+from tiago_description.kinematics import RobotKinematics, head_angles_towards, within_head_limits
 from tiago_description.motion_library import HotelGrasp
-from tiago_skills.base_alignment import align_base, working_pose
+from tiago_skills.base_alignment import HEAD_JOINTS, align_base, search_marker, working_pose
 from tiago_skills.behaviours import (
     FLIP_ABOUT_APPROACH,
     TOOL_SPEED_FREE,
     TOOL_SPEED_INTO_POCKET,
     RobotBehaviours,
+    move_joints,
 )
 from tiago_skills.bench_route import BenchRoute, held_plate_box, station_boxes
 from tiago_skills.goal_run import ActionAbort, GoalRun
 from tiago_skills.perception.aruco import detect_marker
+from tiago_skills.perception.nest_occupancy import NestView, view_nest
 from tiago_skills.perception.site_frames import nest_in_base
 from tiago_skills.place_correction import place_shift
 
 log = logging.getLogger(__name__)
 
-TARGETS = ("site_approach", "site", "work_pose")
+TARGETS = ("site_approach", "site", "work_pose", "inspect")
 LINE_ONLY_RADIUS_M = 0.03  # a tool this near the column above the site moves only in straight lines
 CAMERA_FRAME = "head_front_camera_rgb_optical_frame"
 # A cached marker stays valid while odometry moved less than this.
@@ -124,6 +128,58 @@ class MarkerMotionBehaviour:
         turned = abs(math.remainder(yaw - sighting.odometry[2], math.tau))
         return sighting if moved < SAME_BASE_POSITION_M and turned < SAME_BASE_YAW_RAD else None
 
+    def _sighting_here(self, run: GoalRun, station: Any) -> MarkerSighting:
+        """The marker's sighting from where the base stands: the cached one, else a search from
+        where localisation puts the base."""
+        sighting = self._cached(run, station.name)
+        if sighting is not None:
+            return sighting
+        believed = run.read(lambda hardware: tuple(hardware.pose_estimate()))
+        expected = tf.invert(tf.from_planar(*believed)) @ station.T_world_marker()
+        return search_marker(
+            run, self.kinematics, expected[:3, 3], lambda r: self.look(r, station.name), None
+        )
+
+    def inspect(self, run: GoalRun, station: Any, sub_position: int) -> dict:
+        """Whether a plate lies in the nest, from the depth image: from the head as it stands if the
+        nest is in view, else aimed at it and turned back after, so that a later place measures its
+        held plate with the head where it saw the marker (place_correction); NEST_NOT_SEEN when the
+        camera cannot see into the nest."""
+        sighting = self._sighting_here(run, station)
+        T_marker_site = station.T_marker_site(sub_position)
+        height = float((station.T_world_marker() @ T_marker_site)[2, 3])
+        T_base_site = nest_in_base(sighting.T_base_marker, station.T_table_marker(), T_marker_site, height)
+        view = self._view(run, T_base_site)
+        if not view.seen:
+            joints = run.read(lambda hardware: dict(hardware.joint_positions()))
+            back = {name: joints[name] for name in HEAD_JOINTS}
+            aim = within_head_limits(head_angles_towards(self.kinematics, joints, T_base_site[:3, 3]))
+            log.info(
+                "nest %d of %s not seen from here (%s): aiming the head at it",
+                sub_position,
+                station.name,
+                view.reason,
+            )
+            run.follow(move_joints(aim), span=(0.2, 0.5))
+            view = self._view(run, T_base_site)
+            run.follow(move_joints(back), span=(0.6, 1.0))
+        log.info("nest %d of %s: %s", sub_position, station.name, view.reason)
+        if not view.seen:
+            raise ActionAbort(
+                ErrorCodes.NEST_NOT_SEEN,
+                f"the head camera cannot see into nest {sub_position} of {station.name}: {view.reason}",
+            )
+        return {"marker_in_base": pose_msg(sighting.T_base_marker), "nest_occupied": bool(view.occupied)}
+
+    def _view(self, run: GoalRun, T_base_site: np.ndarray) -> NestView:
+        run.feedback(max(run.progress, 0.1), "looking into the nest", 0.0, force=True)
+        frame = run.read(lambda hardware: hardware.capture_head_camera())
+        with self._lock:
+            T_base_optical = self.kinematics.forward(frame.joints, CAMERA_FRAME)
+        T_site_optical = tf.invert(T_base_site) @ T_base_optical
+        sizes = [(t.length, t.width, t.height) for t in self.world.labware_types.values()]
+        return view_nest(frame.depth, frame.intrinsics, T_site_optical, sizes)
+
     def _centred_on_plate(
         self, run: GoalRun, arm: str, T_base_site: np.ndarray, sighting: MarkerSighting
     ) -> np.ndarray:
@@ -188,6 +244,8 @@ class MarkerMotionBehaviour:
                 run, station, self.kinematics, lambda r: self.look(r, station.name), posture, T_world_work
             )
             return {"marker_in_base": pose_msg(sighting.T_base_marker)}
+        if goal.target == "inspect":
+            return self.inspect(run, station, sub_position)
         sighting = self._cached(run, station.name)
         if sighting is None:
             sighting = self.look(run, station.name)

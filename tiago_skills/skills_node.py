@@ -120,4 +120,7 @@ class RobotSkills:
         response.hotel_slots = workcell.hotel_slots
         response.pois = list(workcell.pois)
         response.dock_poi = workcell.dock_poi
+        response.nest_sensors = workcell.sensors.nests
+        response.hotel_sensors = workcell.sensors.hotel
+        response.label_readers = workcell.sensors.label_readers
         return response

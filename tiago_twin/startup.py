@@ -23,7 +23,7 @@ import numpy as np
 from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
 
-from lab_description.world import DEFAULT_WORLD, World, WorldError, load_world
+from lab_description.world import DEFAULT_WORLD, World, WorldError, load_world, with_stock_sensors
 from tiago_description.motion_library import DEFAULT_MOTIONS_FILE
 from tiago_sim.measuring.run_recorder import RunRecorder
 from tiago_sim.node_main import spin_node
@@ -93,6 +93,11 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         f"as they would a real TIAGo++; serves them, and paces motion at {ADAPTER_PACE:g} times real time "
         f"at most unless --realtime-factor-cap says otherwise (at most {ADAPTER_MAX_PACE:g})",
     )
+    parser.add_argument(
+        "--stock-sensors",
+        action="store_true",
+        help="the lab has none of the lab-added plate sensors (the world file's `sensors` all off)",
+    )
     parser.add_argument("--log-level", default="INFO")
     parser.add_argument(
         "--near-misses",
@@ -117,6 +122,9 @@ def main(argv: list[str] | None = None) -> int:
         # One line (a problem per line otherwise) that a parent process can show as it is.
         sys.stderr.write(f"invalid world file: {'; '.join(error.problems)}\n")
         return INVALID_WORLD_EXIT_CODE
+    if args.stock_sensors:
+        world = with_stock_sensors(world)
+    log.info("lab-added plate sensors: %s", ", ".join(world.sensors.names()) or "none (a stock TIAGo++)")
     from tiago_sim.physics.simulation import (
         Simulation,  # heavy import (PyBullet), only in the process that owns it
     )

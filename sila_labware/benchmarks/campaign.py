@@ -17,9 +17,7 @@ them); here they are flags in mm, degrees and percent. Threads: the caller's (th
 
 from __future__ import annotations
 
-import json
 import logging
-import math
 import statistics
 import sys
 import time
@@ -28,6 +26,7 @@ from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any, TextIO
 
+from sila_labware.benchmarks.levels import levels_json
 from sila_labware.deployment.demo import MISPLACED, DemoReport, run_demo
 from sila_labware.deployment.processes import interrupt_requested
 from sila_labware.deployment.stack import Deployment, DeploymentOptions
@@ -42,6 +41,7 @@ CAUSE_BY_ERROR_CODE = {
     "NAVIGATION_FAILED": "navigation",
     "DOCKED": "navigation",
     "MARKER_NOT_FOUND": "perception",
+    "NEST_NOT_SEEN": "perception",
     "GRASP_FAILED": "grasp",
     "PLATE_SLIPPED": "grasp",
     "SLOT_EMPTY": "grasp",  # the plate the robot thought it had stowed is not on board
@@ -50,57 +50,6 @@ CAUSE_BY_ERROR_CODE = {
     "NEST_OCCUPIED": "positioning",
 }
 BASE_MOTION_WORDS = ("driving to", "Dock", "Undock")
-
-
-@dataclass(frozen=True)
-class LevelFlag:
-    """One disturbance level: CLI flag in human units, its SI field for the sim node, the default."""
-
-    flag: str
-    field: str
-    to_si: float  # multiply the flag value by this to get the SI value
-    default: float  # in the flag's unit
-    help: str
-
-
-LEVEL_FLAGS = (
-    LevelFlag("--nav-error-mm", "navigation_xy_m", 1e-3, 30.0, "base stop error after navigation, per axis"),
-    LevelFlag(
-        "--nav-error-deg", "navigation_yaw_rad", math.pi / 180, 2.0, "base heading error after navigation"
-    ),
-    LevelFlag("--odometry-noise-pct", "odometry_noise", 1e-2, 0.2, "wheel radius error and slip per wheel"),
-    LevelFlag("--station-error-mm", "station_xy_m", 1e-3, 10.0, "station (table) placement error, per axis"),
-    LevelFlag("--station-error-deg", "station_yaw_rad", math.pi / 180, 1.0, "station heading error"),
-    LevelFlag("--marker-error-mm", "marker_xy_m", 1e-3, 1.0, "marker mounted off its place, per axis"),
-    LevelFlag("--marker-error-deg", "marker_yaw_rad", math.pi / 180, 0.5, "marker rotated in its plane"),
-    LevelFlag("--nest-error-mm", "nest_xy_m", 1e-3, 1.0, "nest row mounted off its place, per axis"),
-    LevelFlag("--nest-error-deg", "nest_yaw_rad", math.pi / 180, 0.3, "nest row rotated on the table"),
-    LevelFlag("--camera-noise", "camera_noise", 1.0, 2.0, "head camera read noise, 8-bit grey levels"),
-    LevelFlag("--plate-mass-pct", "plate_mass_spread", 1e-2, 10.0, "plate mass spread"),
-    LevelFlag("--plate-friction-pct", "plate_friction_spread", 1e-2, 15.0, "plate friction spread"),
-    LevelFlag("--depth-noise-mm", "depth_noise_m", 1e-3, 1.9, "depth noise per pixel at 1 m (~z^2)"),
-    LevelFlag("--depth-bias-mm", "depth_bias_m", 1e-3, 1.0, "depth bias per trial at 1 m (~z^2)"),
-    LevelFlag("--camera-mount-mm", "camera_mount_xyz_m", 1e-3, 1.0, "hand-eye error of the camera, per axis"),
-    LevelFlag(
-        "--camera-mount-deg", "camera_mount_rpy_rad", math.pi / 180, 0.1, "hand-eye rotation error, per axis"
-    ),
-    LevelFlag(
-        "--joint-offset-deg", "joint_offset_rad", math.pi / 180, 0.1, "encoder zero error per arm/head joint"
-    ),
-    LevelFlag("--id-read-failure-pct", "id_read_failure", 1e-2, 0.1, "chance that a barcode read fails"),
-    LevelFlag("--bench-height-error-mm", "bench_height_m", 1e-3, 1.0, "bench top higher than the world file"),
-)
-
-
-def levels_json(values: dict[str, float]) -> str:
-    """Flag values (keyed by SI field name, human units) -> the sim node's --disturbance-levels."""
-    return json.dumps(
-        {level.field: values[level.field] * level.to_si for level in LEVEL_FLAGS}, sort_keys=True
-    )
-
-
-def default_level_values(scale: float = 1.0) -> dict[str, float]:
-    return {level.field: level.default * scale for level in LEVEL_FLAGS}
 
 
 def classify_failure(report: DemoReport) -> str:
@@ -145,13 +94,21 @@ class CampaignOptions:
     jobs: int = 1  # trials run side by side, each worker with its own robot side, ports and ROS domain
     layouts_dir: Path | None = None  # random layouts: trial seed S runs in layouts_dir/layout_S.yaml
     layouts_flag: str = "--random-layouts"  # the bench flag that drew them (for the replay line)
+    real_robot: bool = False  # no lab-added sensors, Nav2's stop tolerances (bench --real-robot)
 
 
 def trial_stack(options: CampaignOptions, trial_seed: int, worker: int = 0) -> DeploymentOptions:
     """One trial's deployment: its world (random layout or the campaign's); the worker's own SiLA ports,
     ROS domain (a requested id shifted by the worker index) and CA file (a shared one let a client
     read another worker's CA and refuse its own servers); a robot side forked prewarmed."""
-    extra = ["--disturbance-seed", str(trial_seed), "--disturbance-levels", levels_json(options.levels)]
+    extra = [
+        *options.stack.extra_sim_arguments,
+        *(["--stock-sensors"] if options.real_robot else []),
+        "--disturbance-seed",
+        str(trial_seed),
+        "--disturbance-levels",
+        levels_json(options.levels),
+    ]
     layouts, domain_id, ca = options.layouts_dir, options.stack.domain_id, options.stack.ca_file
     return replace(
         options.stack,
@@ -263,7 +220,8 @@ def run_campaign(
 def replay_flags(options: CampaignOptions) -> str:
     """What `bench --replay SEED` needs besides the seed to run a trial of this campaign again."""
     world = f" --world {options.stack.world}" if options.layouts_flag == "--random-obstacles" else ""
-    return f" {options.layouts_flag}{world}" if options.layouts_dir is not None else ""
+    layouts = f" {options.layouts_flag}{world}" if options.layouts_dir is not None else ""
+    return layouts + (" --real-robot" if options.real_robot else "")
 
 
 def record_outcome(

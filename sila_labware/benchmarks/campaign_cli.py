@@ -23,7 +23,6 @@ from pathlib import Path
 from typing import Any
 
 from sila_labware.benchmarks.campaign import (
-    LEVEL_FLAGS,
     PORTS_PER_WORKER,
     CampaignOptions,
     TrialOutcome,
@@ -32,6 +31,7 @@ from sila_labware.benchmarks.campaign import (
     run_campaign,
     summarize,
 )
+from sila_labware.benchmarks.levels import LEVEL_FLAGS, REAL_ROBOT_LEVELS
 from sila_labware.benchmarks.random_layouts import (
     LayoutGenerationError,
     generate_layouts,
@@ -100,6 +100,13 @@ def add_bench_arguments(bench: argparse.ArgumentParser) -> None:
     bench.add_argument(
         "--level-scale", type=float, default=1.0, help="multiply every default level (0: no disturbance)"
     )
+    bench.add_argument(
+        "--real-robot",
+        action="store_true",
+        help="a real TIAGo++'s conditions: no lab-added sensors (--stock-sensors) and navigation "
+        "stopping anywhere Nav2's default goal checker allows (0.25 m, 0.25 rad; sets --nav-error-mm "
+        "and --nav-error-deg unless given)",
+    )
     levels = bench.add_argument_group("disturbance levels (one standard deviation each)")
     for level in LEVEL_FLAGS:
         levels.add_argument(
@@ -136,6 +143,8 @@ def level_values(args: argparse.Namespace) -> dict[str, float]:
     values = {}
     for level in LEVEL_FLAGS:
         given = getattr(args, f"level_{level.field}")
+        if given is None and getattr(args, "real_robot", False):
+            given = REAL_ROBOT_LEVELS.get(level.field)
         values[level.field] = given if given is not None else level.default * args.level_scale
     return values
 
@@ -157,7 +166,9 @@ def bench_command(args: argparse.Namespace, stack: DeploymentOptions) -> int:
     # 9 s start-up (measured), so a bench serves without discovery.
     stack = replace(stack, discovery=False)
     jobs = min(args.jobs, trials)
-    options = CampaignOptions(stack, first_seed, trials, levels, record_dir=frames_dir, jobs=jobs)
+    options = CampaignOptions(
+        stack, first_seed, trials, levels, record_dir=frames_dir, jobs=jobs, real_robot=args.real_robot
+    )
     with tempfile.TemporaryDirectory(prefix="sila-labware-layouts-") as scratch:
         if args.random_layouts or args.random_obstacles:
             furnish = stack.world if args.random_obstacles else None

@@ -28,6 +28,7 @@ from ros_bridge.robot_link import RobotLink
 from sila_labware.client import StepProgress
 from sila_labware.client.console import ProgressLine
 from sila_labware.deployment.clients import transfer_client
+from sila_labware.deployment.plate_names import plate_named_at
 from sila_labware.deployment.stack import Deployment
 
 logger = logging.getLogger(__name__)
@@ -104,7 +105,9 @@ def run_demo(deployment: Deployment, progress_stream: TextIO | None = sys.stderr
         report.error = f"need a plate on {source.name} and a free nest on {destination.name}"
         return report
     plate_nest, free_nest = plate_reading.nest, free_reading.nest
-    plate_id = plate_reading.labware_id
+    # Without a label read at the source, the demo names its plate as a scheduler would: here, as
+    # the world file does (a stock TIAGo++ reads no labels).
+    plate_id = plate_reading.labware_id or plate_named_at(deployment.options.world, plate_nest)
     report.labware_id = plate_id
     report.source = str(plate_nest)
     report.destination = str(free_nest)

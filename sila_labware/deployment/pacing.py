@@ -41,6 +41,23 @@ def add_ros_adapter_argument(parser: argparse.ArgumentParser) -> None:
     )
 
 
+def add_sensor_argument(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--stock-sensors",
+        action="store_true",
+        help="the lab has none of the lab-added plate sensors (nests, hotel pockets, label readers), as "
+        "with a stock TIAGo++: the robot checks nests with its head camera and its hotel with its "
+        "fingers (overrides the world file's `sensors`)",
+    )
+
+
+def add_robot_arguments(parser: argparse.ArgumentParser) -> None:
+    """How the simulated robot runs for serve and demo: its pace, its adapter, its sensors."""
+    add_pace_argument(parser)
+    add_ros_adapter_argument(parser)
+    add_sensor_argument(parser)
+
+
 def pace_problem(pace: float | None, ros_adapter: bool = False) -> str | None:
     """Why `pace` is no usable pace (None: it is, or none was asked for)."""
     if pace is None:

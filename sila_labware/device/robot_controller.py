@@ -300,6 +300,19 @@ class RobotController:
         Presence only: a label that reads other than the plate's name is a note, not a slip."""
         getting = command == "GetLabware"
         expected: Location = HotelSlot(transfer.internal_position) if getting else transfer.handover
+        sensors = self.workcell.sensors
+        if not (sensors.hotel if getting else sensors.nests):
+            # No presence sensor there: the robot side checked the place otherwise (the fingers'
+            # gap in the pocket, the head camera in the nest) and settled its inventory on it.
+            record = self.inventory.at(expected)
+            if record is not None and (not labware_id or record.labware_id == labware_id):
+                return
+            code = "PLATE_SLIPPED" if getting else "PLACE_FAILED"
+            raise TransferFailed(
+                code,
+                f"{command} failed ({code}): the robot side reported success, but its inventory has no "
+                f"plate at {expected}",
+            )
         try:
             if getting:
                 self.link.wait_for_robot_status(
@@ -336,7 +349,17 @@ class RobotController:
         )
 
     def _refuse_occupied_destination(self, handover: Nest) -> None:
-        """Before any motion: a nest whose sensor sees a plate cannot take another one."""
+        """Before any motion: a nest whose sensor sees a plate cannot take another one; where the
+        nests have no sensors, one the inventory places a plate in (the robot's head camera then
+        looks before it places)."""
+        if not self.workcell.sensors.nests:
+            record = self.inventory.at(handover)
+            if record is not None:
+                raise CommandSequenceError(
+                    f"PrepareForOutput refused: the inventory has {record.labware_id or 'a plate'} at "
+                    f"destination {handover}; the robot did not move"
+                )
+            return
         for reading in self.link.nest_readings():
             if reading.nest == handover and reading.occupied:
                 holder = f" (holds {reading.labware_id})" if reading.labware_id else ""
@@ -347,7 +370,10 @@ class RobotController:
 
     def _hotel_occupant(self, status: RobotStatus, slot: int) -> str | None:
         """The name of the plate in the hotel slot ("" for a plate nobody named); None when its
-        presence sensor sees none."""
+        presence sensor sees none, or, where the hotel has no sensors, the inventory records none."""
+        if not self.workcell.sensors.hotel:
+            record = self.inventory.in_hotel_slot(slot)
+            return None if record is None else record.labware_id
         for reading in status.hotel:
             if reading.slot.index == slot and reading.occupied:
                 record = self.inventory.in_hotel_slot(slot)

@@ -16,12 +16,12 @@ from pathlib import Path
 from types import ModuleType
 
 import pytest
-import yaml
 
 from labware_model.holders import Nest
 from sila_labware.client.sequence import PICK_STEPS, PLACE_STEPS, TRANSFER_STEPS
 from sila_labware.deployment.stack import Deployment
-from tests.helpers.sila_stack import DEFAULT_WORLD, REPOSITORY, start_stack
+from tests.helpers.sila_stack import REPOSITORY, start_stack
+from tests.helpers.world_variants import default_world_with
 
 EXAMPLES = REPOSITORY / "examples"
 FIRST, SECOND = "plate_001", "plate_002"
@@ -38,12 +38,7 @@ def load_example(name: str) -> ModuleType:
 
 def world_with_two_plates(directory: Path) -> Path:
     """The default world with a second plate in station_a/2; station_b's two nests are free."""
-    world = yaml.safe_load(DEFAULT_WORLD.read_text())
-    first = world["plates"][0]
-    world["plates"].append({**first, "id": SECOND, "station": "station_a", "sub_position": 2})
-    path = directory / "two_plates.yaml"
-    path.write_text(yaml.safe_dump(world))
-    return path
+    return default_world_with(directory / "two_plates.yaml", {SECOND: ("station_a", 2)})
 
 
 @pytest.fixture(scope="module")

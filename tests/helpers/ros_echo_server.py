@@ -82,6 +82,7 @@ class EchoRobot(Node):
         response.hotel_slots = 2
         response.pois = ["reader_poi", "rack_poi", "dock_approach"]
         response.dock_poi = "dock_approach"
+        response.nest_sensors = response.hotel_sensors = response.label_readers = True
         return response
 
     def _publish_state(self) -> None:

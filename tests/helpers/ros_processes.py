@@ -158,3 +158,23 @@ class RosCaller:
             return self.spin_until(client.call_async(request), timeout_s)
         finally:
             self.node.destroy_client(client)
+
+
+@contextmanager
+def robot_side(logs: Path, caller_name: str, *twin_arguments: str) -> Iterator[RosCaller]:
+    """tiago_twin (with `twin_arguments`) and the sequencer as real processes, and a caller.
+    Both must still run when the block ends, then stop cleanly on SIGTERM, logging no traceback."""
+    with (
+        running("tiago_twin", *twin_arguments, log_path=logs / "sim_node.log") as sim,
+        running("tiago_sim.sequencer", log_path=logs / "sequencer.log") as sequencer,
+    ):
+        caller = RosCaller(caller_name)
+        try:
+            yield caller
+        finally:
+            caller.close()
+            for process, name in ((sim, "sim_node"), (sequencer, "sequencer")):
+                assert process.poll() is None, f"{name} died early; see {logs / (name + '.log')}"
+    for process, name in ((sim, "sim_node"), (sequencer, "sequencer")):
+        assert process.returncode == 0, f"{name} did not exit cleanly on SIGTERM: {process.returncode}"
+        assert "Traceback" not in (logs / f"{name}.log").read_text(), f"{name} logged a traceback"

@@ -40,6 +40,7 @@ class SilentWorkcell(Node):
             time.sleep(0.02)
         response.stations = [StationInfo(name="station_a", sub_positions=2, poi="station_a_work")]
         response.hotel_slots, response.pois, response.dock_poi = 2, ["station_a_work", "dock"], "dock"
+        response.nest_sensors = response.hotel_sensors = response.label_readers = True
         return response
 
 

@@ -75,7 +75,7 @@ RULES: list[tuple[str, Mutation, str]] = [
         "a furniture list is no part of the schema",
         lambda d: d.update(furniture=[[1.0, 2.0, 0.3]]),
         "furniture: unknown key; expected one of dock, floor_size, labware_types, name, obstacles, plates, "
-        "pois, robot, stations",
+        "pois, robot, sensors, stations",
     ),
     # missing keys and types
     ("missing key", lambda d: station(0, "table")(d).pop("pose"), "stations[0].table.pose: missing"),

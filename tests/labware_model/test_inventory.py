@@ -100,3 +100,15 @@ def test_whatever_the_sensors_say_a_holder_holds_at_most_one_named_plate(steps) 
         book.settle(name, (holder,), sensed)
         placed = [record.location for record in book.records() if record.location != UNKNOWN]
         assert len(placed) == len(set(placed))
+
+
+def test_a_holder_without_a_sensor_keeps_the_plate_its_checked_steps_put_there() -> None:
+    """A hotel without sensors: a delivered plate is where the transfer put it; one that no grasp
+    touched stays where it lay; a sensor that sees it elsewhere still wins."""
+    book = LabwareBook([LabwareRecord("p1", "", A1, "")])
+    assert book.settle("p1", (SLOT1, GRIPPER, A1), [], unsensed=SLOT1)
+    assert book.get("p1").location == SLOT1
+    assert not book.settle("p1", (B1, GRIPPER, SLOT1), [], unsensed=SLOT1)  # refused before the grasp
+    assert book.get("p1").location == SLOT1
+    assert book.settle("p1", (B1, GRIPPER, SLOT1), [SensedPlate(B1)], unsensed=SLOT1)
+    assert book.get("p1").location == B1

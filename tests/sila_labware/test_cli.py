@@ -316,3 +316,29 @@ def test_serve_logs_each_refusal_as_one_warning_line_without_a_traceback(tmp_pat
     assert "NoneType: None" not in log
     for command in ("GetLabware", "PrepareForOutput", "DriveToPointOfInterest"):
         assert sum(command in line for line in refused) == 1, (command, refused)
+
+
+def test_demo_with_stock_sensors_delivers_on_the_camera_and_finger_checks(tmp_path: Path) -> None:
+    """No lab-added sensor (`--stock-sensors`): the SiLA side and the robot side check the hotel by
+    the fingers and the nest by the head camera, and the demo names its plate as the world file does."""
+    logs = tmp_path / "logs"
+    done = run_cli(
+        "demo",
+        "--json",
+        "--stock-sensors",
+        "--insecure",
+        "--no-discovery",
+        "--port-base",
+        str(free_port_base(4)),
+        "--log-dir",
+        str(logs),
+        timeout_s=600,
+        temp_dir=tmp_path / "tmp",
+    )
+    report = json.loads(done.stdout)
+    assert report["success"] is True, report
+    assert report["labware_id"] == "plate_001"
+    sequencer = (logs / "sequencer.log").read_text()
+    assert "lab-added sensors read: none" in sequencer
+    assert sequencer.count("target=inspect") == 2, "the nest is looked into before and after the place"
+    assert "/station_states" not in sequencer

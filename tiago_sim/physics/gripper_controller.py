@@ -83,6 +83,7 @@ class Gripper:
 
     def command(self, finger_position: float, force_n: float | None = None) -> None:
         """Fingers to ``finger_position`` with ``force_n`` each (default: the grip force)."""
+        self.closed = finger_position < rm.FINGER_TRAVEL / 2
         force = self.grip_force_n if force_n is None else force_n
         self.body.command_positions(
             {name: finger_position for name in self.fingers}, force_scale=force / rm.FINGER_EFFORT
@@ -91,7 +92,12 @@ class Gripper:
     def opening(self) -> float:
         """Gap between the pads in m."""
         joints = self.body.joint_positions()
-        return 2 * rm.FINGER_MOUNT_OFFSET + sum(joints[n] for n in self.fingers)
+        return rm.finger_gap(joints[n] for n in self.fingers)
+
+    def holds_by_gap(self) -> bool:
+        """What a real gripper's joint states say: commanded closed, and stopped on something."""
+        joints = self.body.joint_positions()
+        return rm.holds_by_gap(self.closed, (joints[n] for n in self.fingers))
 
     def _pads_on(self, plate: int) -> list[bool]:
         """Whether each pad touches the plate body ``plate``."""
@@ -206,8 +212,10 @@ class GripperMotion(Motion):
             if not self.close:
                 gripper.detach()  # open: nothing is held, whatever the contacts say
             else:
+                # Holding is what the fingers' gap says, as on a robot; the travel attach (the
+                # simulation's stand-in for friction) needs both pads on one plate besides.
+                self.holding = gripper.holds_by_gap()
                 labware_id = gripper.touching()
-                self.holding = bool(labware_id) and self.opening_m > 2 * rm.FINGER_MOUNT_OFFSET + 0.002
-                if self.holding:
+                if self.holding and labware_id:
                     gripper.attach(labware_id)
             self.finish(True, message="holding" if self.holding else "")

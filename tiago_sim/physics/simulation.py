@@ -285,10 +285,9 @@ class Simulation:
         return self.plate_sensing.plate_bottom(labware_id)
 
     def gripper_holds(self, arm: str) -> bool:
-        """A plate between that gripper's pads (both touching) or attached: the fingers' presence
-        reading, which needs no label."""
-        gripper = self.grippers[arm]
-        return bool(gripper.touching() or gripper.attached_id)
+        """That gripper holds something, as its fingers' joint states say (closed on it): the
+        presence reading a real TIAGo++ has, which needs no label and no contact query."""
+        return self.grippers[arm].holds_by_gap()
 
     def held_labware(self, arm: str) -> str:
         """Plate between that gripper's pads (both touching), or the one attached after a verified grasp,

@@ -13,6 +13,8 @@ from __future__ import annotations
 import logging
 import os
 import time
+from collections.abc import Mapping
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -23,6 +25,7 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from labware_model.holders import GRIPPER, HotelSlot, Location, Nest, location_text
 from labware_model.inventory import LabwareBook, NameTaken, SensedPlate, sensed_plates
 from labware_model.readings import HotelSlotReading, NestReading
+from labware_model.workcell import LabSensors
 from tiago_sim.sequencer.plans import TaskRefused
 
 log = logging.getLogger("tiago_sim.sequencer.inventory")
@@ -48,10 +51,26 @@ def nest_readings(station_states: Any) -> tuple[NestReading, ...]:
     )
 
 
-def sensed_now(robot_state: Any, station_states: Any) -> tuple[tuple[SensedPlate, ...], set[Location]]:
-    """What the sensors see, and every holder that has a sensor, from one pair of state messages."""
-    hotel, nests = hotel_readings(robot_state), nest_readings(station_states)
-    plates = sensed_plates(hotel, bool(robot_state.holding), robot_state.held_labware_id, nests)
+def sensed_now(
+    robot_state: Any,
+    station_states: Any,
+    sensors: LabSensors | None = None,
+    camera_nests: Mapping[Nest, bool] | None = None,
+) -> tuple[tuple[SensedPlate, ...], set[Location]]:
+    """What the sensors see, and every holder that has a sensor, from one pair of state messages:
+    only the sensors the lab has (`sensors`; None: all), the fingers' gap always, and the nests the
+    head camera looked into (`camera_nests`) where the nests have none."""
+    sensors = sensors or LabSensors()
+    hotel = hotel_readings(robot_state) if sensors.hotel else ()
+    if sensors.nests and station_states is not None:
+        nests = nest_readings(station_states)
+    else:
+        nests = tuple(NestReading(nest, occupied, "") for nest, occupied in (camera_nests or {}).items())
+    held_label = robot_state.held_labware_id if sensors.label_readers else ""
+    if not sensors.label_readers:
+        hotel = tuple(replace(r, labware_id="") for r in hotel)
+        nests = tuple(replace(r, labware_id="") for r in nests)
+    plates = sensed_plates(hotel, bool(robot_state.holding), held_label, nests)
     holders: set[Location] = {r.slot for r in hotel} | {r.nest for r in nests} | {GRIPPER}
     return plates, holders
 
@@ -139,16 +158,30 @@ class InventoryKeeper:
             self.changed()
         return record.labware_id if record is not None else ""
 
-    def reconcile(self, robot_state: Any, station_states: Any) -> None:
-        """Follow the sensors (between transfers only: the caller knows)."""
-        plates, holders = sensed_now(robot_state, station_states)
+    def reconcile(self, robot_state: Any, station_states: Any, sensors: LabSensors | None = None) -> None:
+        """Follow the sensors the lab has (between transfers only: the caller knows)."""
+        plates, holders = sensed_now(robot_state, station_states, sensors)
         if self.book.reconcile(plates, holders) or not self.followed_sensors:
             self.followed_sensors = True
             self.changed()
 
-    def settle(self, name: str, candidates: tuple[Location, ...], robot_state: Any, stations: Any) -> None:
-        """After a transfer (LabwareBook.settle), from the latest reports."""
-        if name and self.book.settle(name, candidates, sensed_now(robot_state, stations)[0]):
+    def settle(
+        self,
+        name: str,
+        candidates: tuple[Location, ...],
+        robot_state: Any,
+        stations: Any,
+        sensors: LabSensors | None = None,
+        *,
+        camera_nests: Mapping[Nest, bool] | None = None,
+        unsensed_at: Location | None = None,
+    ) -> None:
+        """After a transfer (LabwareBook.settle), from the latest reports. Where no sensor sees
+        the plate, it is at `unsensed_at` if that holder has no sensor: the destination of a
+        delivered plate (its checked steps put it there), the source of one no grasp touched."""
+        plates, holders = sensed_now(robot_state, stations, sensors, camera_nests)
+        unsensed = unsensed_at if unsensed_at not in holders else None
+        if name and self.book.settle(name, candidates, plates, unsensed):
             record = self.book.get(name)
             log.info("labware %s is now at %s", name, location_text(record.location) if record else "?")
             self.changed()

@@ -17,7 +17,9 @@ A step is done when its sensors say so: after a step with a post-condition (plan
 task waits at most `post_check_s` for a sensor report read after the step ended that shows the
 plate where it must be; otherwise it fails with the step's code (PLATE_SLIPPED, PLACE_FAILED)
 naming what the sensor saw, and after those (and GRASP_FAILED) the arm backs out empty and tucks
-(plans.retreat_steps).
+(plans.retreat_steps). Which sensors there are comes from /describe_workcell (`LabSensors`); a
+lab without nest sensors is not read on /station_states at all: the head camera's look into the
+nest (a /marker_motion "inspect" step) settles those checks with its result.
 
 Every wait is bounded: a sub-goal that gives no result within `step_timeout_s` is cancelled and
 the task aborts with NAVIGATION_FAILED (navigate, undock) or MOTION_FAILED, naming the step; a
@@ -33,15 +35,9 @@ import time
 from pathlib import Path
 from typing import Any
 
-from action_msgs.msg import GoalStatus
 from labware_interfaces.action import (
     GetLabware,
-    Gripper,
-    MarkerMotion,
-    NavigateToPoi,
-    PlayMotion,
     PutLabware,
-    Undock,
 )
 from labware_interfaces.msg import ErrorCodes, RobotState, StationStates
 from labware_interfaces.srv import DescribeWorkcell
@@ -50,7 +46,7 @@ from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.task import Future
 
-from labware_model.holders import GRIPPER
+from labware_model.holders import GRIPPER, Location, Nest
 from labware_model.workcell import WorkcellDescription
 from tiago_sim.sequencer.inventory_keeper import InventoryKeeper
 from tiago_sim.sequencer.plans import (
@@ -60,26 +56,19 @@ from tiago_sim.sequencer.plans import (
     TaskRefused,
     ends_of,
     get_plan,
+    is_inspection,
     label_at_source,
     put_plan,
     retreat_steps,
 )
 from tiago_sim.sequencer.postconditions import topic_of, unmet
 from tiago_sim.sequencer.step_durations import StepDurations, table_from_parameters
+from tiago_sim.sequencer.sub_goals import SUB_ACTIONS, run_step
 from tiago_sim.sequencer.task_run import StepFailed, TaskRun
-from tiago_sim.sequencer.waits import describe_workcell, sleep, wait_answering, within
+from tiago_sim.sequencer.waits import describe_workcell, sleep, within
 
 log = logging.getLogger("tiago_sim.sequencer")
 
-SUB_ACTIONS = {
-    "undock": (Undock, "/undock"),
-    "navigate": (NavigateToPoi, "/navigate_to_poi"),
-    "play_motion": (PlayMotion, "/play_motion"),
-    "gripper": (Gripper, "/gripper"),
-    "marker_motion": (MarkerMotion, "/marker_motion"),
-}
-# The task's code when a sub-goal gives no result within step_timeout_s (else MOTION_FAILED).
-TIMEOUT_CODES = {"navigate": ErrorCodes.NAVIGATION_FAILED, "undock": ErrorCodes.NAVIGATION_FAILED}
 PARAMETERS = tuple(  # every one in sequencer.yaml, besides estimates_s
     "arm feedback_hz server_wait_s step_timeout_s cancel_wait_s post_check_s describe_timeout_s "
     "describe_attempts state_max_age_s label_checks".split()
@@ -128,12 +117,38 @@ class Sequencer:
         self.feedback_timer = node.create_timer(
             1.0 / max(float(params["feedback_hz"]), 2.0), self._feedback_tick
         )
+        self.camera_nests: dict[Nest, bool] = {}  # this task's looks into nests (no nest sensors)
+        # Which sensors there are decides which reports the inventory follows: asked once the robot
+        # reports (a task of the executor's own: a coroutine run as a subscription's callback is
+        # not resumed once it awaits).
+        self.described_at_start = False
+
+    async def _describe_and_follow(self) -> None:
+        try:
+            workcell = await self._describe()
+        except StepFailed as failure:
+            log.warning("%s; asking again with the first goal", failure.message)
+            return
+        log.info("lab-added sensors read: %s", ", ".join(workcell.sensors.names()) or "none")
+        self._follow_sensors()
+
+    def _state_keys(self) -> tuple[str, ...]:
+        """The state topics this lab's checks read: /station_states only where nests have sensors."""
+        nests = self.workcell is None or self.workcell.sensors.nests
+        return ("robot", "stations") if nests else ("robot",)
+
+    def _book_at(self, holder: Location) -> str | None:
+        record = self.inventory.book.at(holder)
+        return None if record is None else record.labware_id
 
     def param(self, name: str) -> Any:
         return self.node.get_parameter(name).value
 
     def _on_robot_state(self, message: RobotState) -> None:
         self.robot_state = message
+        if not self.described_at_start:
+            self.described_at_start = True
+            self.node.executor.create_task(self._describe_and_follow)
         self.state_times["robot"] = time.monotonic()
         if message.state not in (RobotState.STATE_MANIPULATING, RobotState.STATE_NAVIGATING):
             self.idle_report_at = self.state_times["robot"]
@@ -150,11 +165,12 @@ class Sequencer:
         """Between transfers, the inventory follows the sensors (a plate taken away by hand, the lab
         reset): only with both reports received after the last transfer ended, which settled its
         plate itself from the reports its post-conditions read."""
-        if self.active is not None or len(self.state_times) < 2:
+        if self.active is not None or self.workcell is None or self.robot_state is None:
             return
-        if min(self.state_times.values()) <= self.task_ended_at:
+        times = [self.state_times.get(key, -1e9) for key in self._state_keys()]
+        if min(times) <= self.task_ended_at:
             return
-        self.inventory.reconcile(self.robot_state, self.station_states)
+        self.inventory.reconcile(self.robot_state, self._sensed_nests(), self.workcell.sensors)
 
     def _report_in(self) -> None:
         if not self.report_arrived.done():
@@ -184,35 +200,42 @@ class Sequencer:
             self.workcell = await describe_workcell(self.node, self.describe_client, attempts, timeout_s)
         return self.workcell
 
-    def _fresh_states(self) -> tuple[RobotState, StationStates]:
+    def _sensed_nests(self) -> StationStates | None:
+        """/station_states where the lab's nests have sensors, else None (never read)."""
+        return self.station_states if "stations" in self._state_keys() else None
+
+    def _fresh_states(self) -> tuple[RobotState, StationStates | None]:
         max_age = float(self.param("state_max_age_s"))  # waited for in _wait_states
         now = time.monotonic()
-        for key, what in (("robot", "/robot_state"), ("stations", "/station_states")):
+        for key in self._state_keys():
             if now - self.state_times.get(key, -1e9) > max_age:
-                raise StepFailed(ErrorCodes.INTERNAL, f"no recent {what}: is the robot running?")
-        assert self.robot_state is not None and self.station_states is not None
-        return self.robot_state, self.station_states
+                raise StepFailed(ErrorCodes.INTERNAL, f"no recent {STATE_TOPICS[key]}: is the robot running?")
+        assert self.robot_state is not None
+        return self.robot_state, self._sensed_nests()
+
+    def _states_since(self, moment: float) -> bool:
+        return all(self.state_times.get(key, -1e9) > moment for key in self._state_keys())
 
     async def _plan(self, request: Any, make_plan: Any, arrived: float) -> list[Step]:
         """The goal's steps, or TaskRefused. A refusal read from the state topics (slot or nest full
         or empty) must also hold in states received after the goal arrived: a plate placed just
         before the goal can be missing from an older message."""
         workcell = await self._describe()
-        await self._wait_ready("/robot_state and /station_states", lambda: len(self.state_times) == 2)
+        topics = " and ".join(STATE_TOPICS[key] for key in self._state_keys())
+        await self._wait_ready(topics, lambda: self._states_since(-1e9))
 
         def plan() -> list[Step]:
             robot_state, station_states = self._fresh_states()
-            return make_plan(request, workcell, robot_state, station_states, str(self.param("arm")))
+            arm = str(self.param("arm"))
+            return make_plan(request, workcell, robot_state, station_states, arm, self._book_at)
 
         try:
             return plan()
         except TaskRefused as refusal:
-            if refusal.code not in STATE_REFUSALS or min(self.state_times.values()) > arrived:
+            if refusal.code not in STATE_REFUSALS or self._states_since(arrived):
                 raise
             log.info("%s read from states older than the goal: reading fresh ones", refusal.code)
-        await self._wait_ready(
-            "/robot_state and /station_states", lambda: min(self.state_times.values()) > arrived
-        )
+        await self._wait_ready(topics, lambda: self._states_since(arrived))
         return plan()
 
     def _execute(self, kind: Any, make_plan: Any) -> Any:
@@ -225,7 +248,7 @@ class Sequencer:
             source, destination = ends_of(request, kind is PutLabware)
             try:
                 plan = await self._plan(request, make_plan, arrived=time.monotonic())
-                label = label_at_source(request, self.robot_state, self.station_states, kind is PutLabware)
+                label = label_at_source(request, self.robot_state, self._sensed_nests(), kind is PutLabware)
                 checks = bool(self.param("label_checks"))
                 result.labware_id = self.inventory.name_for_goal(request, source, label, checks)
             except (TaskRefused, StepFailed) as refusal:
@@ -235,6 +258,8 @@ class Sequencer:
             )
             run = TaskRun.for_plan(goal_handle, kind, plan, self.step_durations, self._robot_seconds)
             self.active = run
+            self.camera_nests = {}
+            touched = False  # a grasp of the plate was tried (until then it lies where it lay)
             try:
                 run.publish()
                 for index, step in enumerate(plan):
@@ -248,8 +273,12 @@ class Sequencer:
                         raise StepFailed(ErrorCodes.CANCELED, f"canceled before {step.describe()}")
                     run.publish()  # a new phase is news: clients see it at once, not at the next tick
                     started = self._robot_seconds()  # a step's time counts its check: clients wait for both
-                    await self._run_step(run, step, f"step {index + 1} of {len(plan)}")
-                    await self._check_post(step, label)
+                    touched = touched or bool(step.expect_holding)
+                    sub_result = await self._run_step(run, step, f"step {index + 1} of {len(plan)}")
+                    if is_inspection(step):
+                        self._check_look(step, sub_result)
+                    else:
+                        await self._check_post(step, label)
                     self.step_durations.record(step, self._robot_seconds() - started, run.task)
                 run.index, run.phase = len(plan), "done"
                 run.publish()  # the last word is progress 1.0
@@ -263,13 +292,22 @@ class Sequencer:
                 return self._finish(goal_handle, result, ErrorCodes.INTERNAL, f"internal error: {error}")
             finally:  # before the result leaves (rclpy sends it once this coroutine returns)
                 self.inventory.settle(
-                    result.labware_id, (destination, GRIPPER, source), self.robot_state, self.station_states
+                    result.labware_id,
+                    (destination, GRIPPER, source),
+                    self.robot_state,
+                    self._sensed_nests(),
+                    self.workcell.sensors if self.workcell is not None else None,
+                    camera_nests=self.camera_nests,
+                    unsensed_at=destination if result.success else (None if touched else source),
                 )
                 result.inventory_revision = self.inventory.revision
                 self.task_ended_at = time.monotonic()
                 self.active = None
 
         return execute
+
+    async def _run_step(self, run: TaskRun, step: Step, which: str) -> Any:
+        return await run_step(self.node, self.clients[step.action], run, step, which, self.answering)
 
     async def _retreat(self, run: TaskRun, plan: list[Step]) -> None:
         """Best effort after the gripper was left empty: bring the arm out of the nest or pocket and
@@ -282,6 +320,20 @@ class Sequencer:
             except StepFailed as failure:
                 log.warning("retreat after the failure stopped: %s", failure.message)
                 return
+
+    def _check_look(self, step: Step, sub_result: Any) -> None:
+        """An inspection's post-condition, from its result: what the head camera saw in the nest."""
+        expect = step.post
+        assert expect is not None and isinstance(expect.holder, Nest)
+        occupied = bool(sub_result.nest_occupied)
+        if not expect.empty:  # a look after the place: a plate there is the task's (a look before is not)
+            self.camera_nests[expect.holder] = occupied
+        if occupied == (not expect.empty):
+            return
+        seen = "a plate" if occupied else "no plate"
+        raise StepFailed(
+            expect.code, f"after {step.phase}: the head camera sees {seen} in nest {expect.holder}"
+        )
 
     async def _check_post(self, step: Step, labware_id: str) -> None:
         """The step's post-condition, read from sensor reports taken after the step ended.
@@ -312,64 +364,10 @@ class Sequencer:
             self.report_arrived = Future()  # completed by the next state message
             await within(self.node, self.report_arrived, deadline - time.monotonic())
 
-    async def _run_step(self, run: TaskRun, step: Step, which: str) -> None:
-        kind, _topic = SUB_ACTIONS[step.action]
-        client = self.clients[step.action]
-        server_wait_s = float(self.param("server_wait_s"))
-        await wait_answering(self.node, client, SUB_ACTIONS[step.action][1], server_wait_s, self.answering)
-        goal = kind.Goal()
-        for field_name, value in step.goal.items():
-            setattr(goal, field_name, value)
-
-        on_feedback, silence = run.follow_sub_goal(step.phase)
-        log.info("%s: %s", which, step.describe())
-        sent = client.send_goal_async(goal, feedback_callback=on_feedback)
-        if not await within(self.node, sent, float(self.param("server_wait_s"))):
-            # an answer that comes after all must not leave a goal running that nobody waits for
-            sent.add_done_callback(lambda done: done.result().accepted and done.result().cancel_goal_async())
-            raise StepFailed(ErrorCodes.INTERNAL, f"{which} ({step.describe()}): the goal was not answered")
-        sub_goal = sent.result()
-        if not sub_goal.accepted:
-            raise StepFailed(ErrorCodes.INTERNAL, f"{step.describe()}: goal rejected")
-        run.sub_goal = sub_goal
-        if run.goal_handle.is_cancel_requested:
-            sub_goal.cancel_goal_async()
-        try:
-            response = await self._result_within_step_timeout(sub_goal, step, which)
-        finally:
-            run.sub_goal = None
-            silence()
-        sub_result = response.result
-        if response.status == GoalStatus.STATUS_CANCELED or sub_result.error_code == ErrorCodes.CANCELED:
-            raise StepFailed(ErrorCodes.CANCELED, f"canceled during {step.describe()}: {sub_result.message}")
-        if not sub_result.success:
-            raise StepFailed(
-                sub_result.error_code or ErrorCodes.INTERNAL, f"{step.describe()}: {sub_result.message}"
-            )
-        if step.expect_holding and not sub_result.holding:
-            raise StepFailed(ErrorCodes.GRASP_FAILED, f"{step.describe()}: nothing between the fingers")
-        run.step_progress, run.step_remaining_s = 1.0, 0.0
-
     def _robot_seconds(self) -> float:
         """The robot's clock as its last state report carried it (simulated time in the twin)."""
         stamp = self.robot_state.stamp if self.robot_state is not None else None
         return stamp.sec + stamp.nanosec * 1e-9 if stamp is not None else 0.0
-
-    async def _result_within_step_timeout(self, sub_goal: Any, step: Step, which: str) -> Any:
-        """The sub-goal's result; past `step_timeout_s` the sub-goal is cancelled and the step fails."""
-        timeout_s = float(self.param("step_timeout_s"))
-        result = sub_goal.get_result_async()
-        if await within(self.node, result, timeout_s):
-            return result.result()
-        log.warning("%s (%s): no result within %g s, cancelling it", which, step.describe(), timeout_s)
-        sub_goal.cancel_goal_async()
-        cancel_wait_s = float(self.param("cancel_wait_s"))
-        ended = await within(self.node, result, cancel_wait_s)
-        code = TIMEOUT_CODES.get(step.action, ErrorCodes.MOTION_FAILED) if ended else ErrorCodes.INTERNAL
-        after = "cancelled" if ended else f"cancelled, and it did not end within {cancel_wait_s:g} s either"
-        raise StepFailed(
-            code, f"{which} ({step.phase}: {step.describe()}) timed out after {timeout_s:g} s: {after}"
-        )
 
     @staticmethod
     def _finish(goal_handle: Any, result: Any, code: str, message: str) -> Any:

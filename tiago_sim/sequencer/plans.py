@@ -17,16 +17,26 @@ Post-conditions, at the points where a plate changes hands or has been carried:
 | final approach (PutLabware, before reaching into the hotel) | hotel slot still sees it | PLATE_SLIPPED |
 | release into the nest (PutLabware) | nest sensor sees the plate | PLACE_FAILED |
 | arm tucked (PutLabware's last step) | nest sensor still sees it | PLACE_FAILED |
+
+A lab whose nests or hotel have no sensors (`LabSensors`, a stock TIAGo++) checks otherwise:
+- no nest sensors: the head camera looks into the destination nest after the final approach (a
+  plate there: NEST_OCCUPIED) and once the arm is tucked (no plate: PLACE_FAILED); a source nest is
+  checked by the grasp itself (nothing between the fingers: GRASP_FAILED);
+- no hotel sensors: the gripper holding the plate down in the pocket before it lets go is the
+  check of a place into the hotel, and the grasp from it the check of a pick (GRASP_FAILED);
+- before anything moves, the inventory stands in for a missing sensor: a slot or nest it records
+  a plate in is full, a slot it records none in is empty.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
 from labware_interfaces.msg import ErrorCodes, RobotState
 
-from labware_model.holders import GRIPPER, Gripper, HotelSlot, Nest
+from labware_model.holders import GRIPPER, Gripper, HotelSlot, Location, Nest
 from labware_model.workcell import WorkcellDescription
 
 # Refusals that rest on what the state topics say (a slot or nest full or empty), not on the goal.
@@ -51,6 +61,7 @@ class Expect:
 
     holder: Gripper | HotelSlot | Nest
     code: str
+    empty: bool = False  # the holder must hold no plate (a nest the head camera checks before a place)
 
 
 @dataclass(frozen=True)
@@ -97,8 +108,15 @@ def check_common(goal: Any, workcell: WorkcellDescription) -> CheckedGoal:
     return CheckedGoal(Nest(station.name, goal.sub_position), HotelSlot(goal.internal_position), station.poi)
 
 
+# The inventory's plate at a holder: its name ("" for an unnamed plate), None when it records none.
+BookLookup = Callable[[Location], "str | None"]
+
+
 def nest_state(station_states: Any, nest: Nest) -> Any | None:
-    """The NestState message of `nest` in a StationStates message, if it reports that nest."""
+    """The NestState message of `nest` in a StationStates message, if it reports that nest (none
+    when the lab's nests have no sensors: `station_states` is None)."""
+    if station_states is None:
+        return None
     for state in station_states.nests:
         if state.station == nest.station and state.sub_position == nest.sub_position:
             return state
@@ -106,7 +124,10 @@ def nest_state(station_states: Any, nest: Nest) -> Any | None:
 
 
 def hotel_slot_state(robot_state: Any, slot: HotelSlot) -> Any | None:
-    """The HotelSlot message of `slot` in a RobotState message, if it reports that slot."""
+    """The HotelSlot message of `slot` in a RobotState message, if it reports that slot (none when
+    the hotel has no sensors: `robot_state` is None)."""
+    if robot_state is None:
+        return None
     for state in robot_state.hotel:
         if state.index == slot.index:
             return state
@@ -153,24 +174,49 @@ def _goal_fields(checked: CheckedGoal, arm: str) -> tuple[dict[str, Any], dict[s
     return site, hotel
 
 
+def _recorded(book: BookLookup, holder: Location) -> str | None:
+    """What the inventory records at `holder`, in words; None when it records no plate there."""
+    name = book(holder)
+    if name is None:
+        return None
+    return (
+        f"{name} (by the inventory: it has no sensor)"
+        if name
+        else "a plate (by the inventory: it has no sensor)"
+    )
+
+
 def get_plan(
-    goal: Any, workcell: WorkcellDescription, robot_state: Any, station_states: Any, arm: str
+    goal: Any,
+    workcell: WorkcellDescription,
+    robot_state: Any,
+    station_states: Any,
+    arm: str,
+    book: BookLookup = lambda _holder: None,
 ) -> list[Step]:
     """Checks, then the steps that take a plate from a station nest into a hotel slot."""
     checked = check_common(goal, workcell)
-    slot = hotel_slot_state(robot_state, checked.hotel_slot)
-    if slot is not None and (slot.occupied or slot.labware_id):
-        occupant = slot.labware_id or "a plate whose label its reader could not read"
+    sensors = workcell.sensors
+    if sensors.hotel:
+        slot = hotel_slot_state(robot_state, checked.hotel_slot)
+        occupied = slot is not None and (slot.occupied or slot.labware_id)
+        occupant = (slot.labware_id or "a plate whose label its reader could not read") if occupied else None
+    else:
+        occupant = _recorded(book, checked.hotel_slot)
+    if occupant is not None:
         raise TaskRefused(
             ErrorCodes.SLOT_OCCUPIED, f"hotel slot {goal.internal_position} already holds {occupant}"
         )
-    nest = nest_state(station_states, checked.nest)
-    if nest is None or not nest.occupied:
-        raise TaskRefused(
-            ErrorCodes.GRASP_FAILED, f"no plate at source {goal.handover_position}:{goal.sub_position}"
-        )
+    if sensors.nests:  # else the grasp is the check: nothing between the fingers is GRASP_FAILED
+        nest = nest_state(station_states, checked.nest)
+        if nest is None or not nest.occupied:
+            raise TaskRefused(
+                ErrorCodes.GRASP_FAILED, f"no plate at source {goal.handover_position}:{goal.sub_position}"
+            )
     site, hotel = _goal_fields(checked, arm)
     held = Expect(GRIPPER, ErrorCodes.PLATE_SLIPPED)
+    in_slot = Expect(checked.hotel_slot, ErrorCodes.PLACE_FAILED) if sensors.hotel else None
+    still_in_slot = Expect(checked.hotel_slot, ErrorCodes.PLATE_SLIPPED) if sensors.hotel else None
     return [
         *travel_steps(robot_state, checked.poi),
         Step("marker_motion", {**site, "target": "work_pose"}, "final approach"),
@@ -182,48 +228,67 @@ def get_plan(
         Step("marker_motion", {**site, "target": "site_approach"}, "lifting", post=held),
         Step("play_motion", {"motion_name": "NestApproach", **hotel}, "to hotel"),
         Step("play_motion", {"motion_name": "Nest", **hotel}, "into hotel", post=held),
-        Step(
-            "gripper",
-            {"command": "open", "arm": arm},
-            "release",
-            post=Expect(checked.hotel_slot, ErrorCodes.PLACE_FAILED),
-        ),
+        Step("gripper", {"command": "open", "arm": arm}, "release", post=in_slot),
         Step("play_motion", {"motion_name": "NestApproach", **hotel}, "retract"),
-        Step(
-            "play_motion",
-            {"motion_name": "Tuck", "arm": arm},
-            "arm tucked",
-            post=Expect(checked.hotel_slot, ErrorCodes.PLATE_SLIPPED),
-        ),
+        Step("play_motion", {"motion_name": "Tuck", "arm": arm}, "arm tucked", post=still_in_slot),
     ]
 
 
 def put_plan(
-    goal: Any, workcell: WorkcellDescription, robot_state: Any, station_states: Any, arm: str
+    goal: Any,
+    workcell: WorkcellDescription,
+    robot_state: Any,
+    station_states: Any,
+    arm: str,
+    book: BookLookup = lambda _holder: None,
 ) -> list[Step]:
     """Checks, then the steps that take a plate from a hotel slot into a station nest."""
     checked = check_common(goal, workcell)
-    nest = nest_state(station_states, checked.nest)
-    if nest is not None and nest.occupied:
-        holder = f" (holds {nest.labware_id})" if nest.labware_id else ""
-        raise TaskRefused(
-            ErrorCodes.NEST_OCCUPIED,
-            f"destination {goal.handover_position}:{goal.sub_position} is occupied{holder}",
-        )
-    slot = hotel_slot_state(robot_state, checked.hotel_slot)
-    if slot is None or not (slot.occupied or slot.labware_id):
-        raise TaskRefused(ErrorCodes.SLOT_EMPTY, f"hotel slot {goal.internal_position} holds no plate")
+    sensors = workcell.sensors
+    where = f"destination {goal.handover_position}:{goal.sub_position}"
+    if sensors.nests:
+        nest = nest_state(station_states, checked.nest)
+        if nest is not None and nest.occupied:
+            holder = f" (holds {nest.labware_id})" if nest.labware_id else ""
+            raise TaskRefused(ErrorCodes.NEST_OCCUPIED, f"{where} is occupied{holder}")
+    else:
+        occupant = _recorded(book, checked.nest)
+        if occupant is not None:
+            raise TaskRefused(ErrorCodes.NEST_OCCUPIED, f"{where} holds {occupant}")
+    if sensors.hotel:
+        slot = hotel_slot_state(robot_state, checked.hotel_slot)
+        empty = slot is None or not (slot.occupied or slot.labware_id)
+    else:
+        empty = book(checked.hotel_slot) is None
+    if empty:
+        by = "" if sensors.hotel else " (by the inventory: the hotel has no sensors)"
+        raise TaskRefused(ErrorCodes.SLOT_EMPTY, f"hotel slot {goal.internal_position} holds no plate{by}")
     site, hotel = _goal_fields(checked, arm)
     held = Expect(GRIPPER, ErrorCodes.PLATE_SLIPPED)
     placed = Expect(checked.nest, ErrorCodes.PLACE_FAILED)
+    # With nest sensors, they check the place; without, the head camera does, before and after.
+    sensed_place = placed if sensors.nests else None
+    look_first, look_after = (
+        ([], [])
+        if sensors.nests
+        else (
+            [
+                inspect_step(
+                    site, "checking the nest is free", Expect(checked.nest, ErrorCodes.NEST_OCCUPIED, True)
+                )
+            ],
+            [inspect_step(site, "checking the plate is in the nest", placed)],
+        )
+    )
     return [
         *travel_steps(robot_state, checked.poi),
         Step(
             "marker_motion",
             {**site, "target": "work_pose"},
             "final approach",
-            post=Expect(checked.hotel_slot, ErrorCodes.PLATE_SLIPPED),
+            post=Expect(checked.hotel_slot, ErrorCodes.PLATE_SLIPPED) if sensors.hotel else None,
         ),
+        *look_first,
         Step("gripper", {"command": "open", "arm": arm}, "opening"),
         Step("play_motion", {"motion_name": "NestApproach", **hotel}, "to hotel"),
         Step("play_motion", {"motion_name": "Nest", **hotel}, "into hotel"),
@@ -231,10 +296,20 @@ def put_plan(
         Step("play_motion", {"motion_name": "NestApproach", **hotel}, "lifting", post=held),
         Step("marker_motion", {**site, "target": "site_approach"}, "approach"),  # via the carry height
         Step("marker_motion", {**site, "target": "site"}, "placing", post=held),
-        Step("gripper", {"command": "open", "arm": arm}, "release", post=placed),
+        Step("gripper", {"command": "open", "arm": arm}, "release", post=sensed_place),
         Step("marker_motion", {**site, "target": "site_approach"}, "retract"),
-        Step("play_motion", {"motion_name": "Tuck", "arm": arm}, "arm tucked", post=placed),
+        Step("play_motion", {"motion_name": "Tuck", "arm": arm}, "arm tucked", post=sensed_place),
+        *look_after,
     ]
+
+
+def inspect_step(site: dict[str, Any], phase: str, post: Expect) -> Step:
+    """A look into the nest with the head camera; its result, not a state topic, settles `post`."""
+    return Step("marker_motion", {**site, "target": "inspect"}, phase, post=post)
+
+
+def is_inspection(step: Step) -> bool:
+    return step.action == "marker_motion" and step.goal.get("target") == "inspect"
 
 
 # Task errors after which the gripper is empty and the arm may stand in a nest or a hotel pocket.

@@ -20,7 +20,7 @@ from rclpy.node import Node
 from rclpy.task import Future
 from unique_identifier_msgs.msg import UUID
 
-from labware_model.workcell import StationDescription, WorkcellDescription
+from labware_model.workcell import WorkcellDescription
 from tiago_sim.sequencer.task_run import StepFailed
 
 log = logging.getLogger("tiago_sim.sequencer")
@@ -87,15 +87,7 @@ async def describe_workcell(node: Node, client: Any, attempts: int, timeout_s: f
     for attempt in range(1, attempts + 1):
         future = client.call_async(DescribeWorkcell.Request())
         if await within(node, future, timeout_s):
-            response = future.result()
-            return WorkcellDescription(
-                stations=tuple(
-                    StationDescription(s.name, int(s.sub_positions), s.poi) for s in response.stations
-                ),
-                hotel_slots=int(response.hotel_slots),
-                pois=tuple(response.pois),
-                dock_poi=response.dock_poi,
-            )
+            return WorkcellDescription.from_message(future.result())
         client.remove_pending_request(future)
         log.warning(
             "/describe_workcell: no answer within %g s (attempt %d of %d)", timeout_s, attempt, attempts

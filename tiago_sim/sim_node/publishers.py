@@ -64,20 +64,30 @@ class RobotSnapshot:
 
 
 def take_snapshot(sim: Any) -> RobotSnapshot:
-    """Read the sensors (runs on the sim thread)."""
+    """Read the sensors the lab has (runs on the sim thread): the world's `sensors` say which of
+    the lab-added ones exist. Without hotel sensors the hotel is not reported at all; without
+    label readers no id is. The nests' sensors are the instruments' own: they are reported
+    whatever the robot's checks read (the station servers follow them)."""
+    sensors = sim.world.sensors
     held = ""
-    for arm in ("right", "left"):
-        held = held or sim.held_labware(arm)
+    if sensors.label_readers:
+        for arm in ("right", "left"):
+            held = held or sim.held_labware(arm)
     holding = any(sim.gripper_holds(arm) for arm in ("right", "left"))
+    hotel = list(sim.hotel_readings()) if sensors.hotel else []
+    nests = list(sim.nest_readings())
+    if not sensors.label_readers:
+        hotel = [replace(r, labware_id="", labware_type="") for r in hotel]
+        nests = [replace(r, labware_id="") for r in nests]
     return RobotSnapshot(
         sim_time=float(sim.sim_time),
         odometry=tuple(float(v) for v in sim.odometry()),
         joint_positions=dict(sim.joint_positions()),
         docked=bool(sim.is_docked()),
-        hotel=list(sim.hotel_readings()),
+        hotel=hotel,
         held_labware_id=held,
         holding=holding,
-        nests=list(sim.nest_readings()),
+        nests=nests,
         true_base_pose=_true_base_pose(sim),
         pose_estimate=tuple(float(v) for v in sim.pose_estimate()),
     )

@@ -22,13 +22,8 @@ import numpy as np
 import pytest
 
 from lab_description.world import load_world
-from sila_labware.benchmarks.campaign import (
-    CAUSES,
-    LEVEL_FLAGS,
-    PORTS_PER_WORKER,
-    classify_failure,
-    levels_json,
-)
+from sila_labware.benchmarks.campaign import CAUSES, PORTS_PER_WORKER, classify_failure
+from sila_labware.benchmarks.levels import LEVEL_FLAGS, levels_json
 from sila_labware.deployment.demo import DemoReport
 from tests.helpers.sila_stack import free_port_base
 from tiago_sim.measuring import disturbances

@@ -12,13 +12,8 @@ from pathlib import Path
 import yaml
 
 from lab_description.world import load_world
-from sila_labware.benchmarks.campaign import (
-    CampaignOptions,
-    TrialOutcome,
-    default_level_values,
-    replay_flags,
-    trial_stack,
-)
+from sila_labware.benchmarks.campaign import CampaignOptions, TrialOutcome, replay_flags, trial_stack
+from sila_labware.benchmarks.levels import default_level_values
 from sila_labware.benchmarks.random_layouts import keep_failed_layouts
 from sila_labware.deployment.stack import DeploymentOptions
 from tests.sila_labware.benchmarks.test_bench import CLI, run_bench

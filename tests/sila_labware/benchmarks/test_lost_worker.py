@@ -12,7 +12,8 @@ import signal
 import time
 from pathlib import Path
 
-from sila_labware.benchmarks.campaign import CampaignOptions, TrialOutcome, default_level_values
+from sila_labware.benchmarks.campaign import CampaignOptions, TrialOutcome
+from sila_labware.benchmarks.levels import default_level_values
 from sila_labware.benchmarks.workers import run_parallel_campaign
 from sila_labware.deployment.stack import DeploymentOptions
 

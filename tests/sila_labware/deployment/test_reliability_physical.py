@@ -26,16 +26,16 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-import yaml
 from rclpy.qos import QoSProfile
 from sensor_msgs.msg import JointState
 from sila2.framework import DefinedExecutionError
 
 from labware_model.holders import FLOOR, Nest
 from ros_bridge.topics import TopicMirror
-from tests.helpers.sila_stack import DEFAULT_WORLD, start_stack
+from tests.helpers.sila_stack import start_stack
 from tests.helpers.sim_parameters import set_node_parameter
 from tests.helpers.transfer_steps import Cell, finish, together
+from tests.helpers.world_variants import default_world_with
 
 PLATE, BLOCKER = "plate_001", "plate_002"
 A1, B1, B2 = ("station_a", 1), ("station_b", 1), ("station_b", 2)
@@ -43,12 +43,7 @@ A1, B1, B2 = ("station_a", 1), ("station_b", 1), ("station_b", 2)
 
 def world_with_blocker(directory: Path) -> Path:
     """The default world with a second plate in station_b/2."""
-    world = yaml.safe_load(DEFAULT_WORLD.read_text())
-    first = world["plates"][0]
-    world["plates"].append({**first, "id": BLOCKER, "station": B2[0], "sub_position": B2[1]})
-    path = directory / "two_plates.yaml"
-    path.write_text(yaml.safe_dump(world))
-    return path
+    return default_world_with(directory / "two_plates.yaml", {BLOCKER: B2})
 
 
 @pytest.fixture(scope="module")

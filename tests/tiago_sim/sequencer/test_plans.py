@@ -7,6 +7,7 @@ what the error says the sensor saw, and how the arm backs out afterwards.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from types import SimpleNamespace
 
 import pytest
@@ -14,8 +15,8 @@ from labware_interfaces.msg import ErrorCodes, HotelSlot, NestState, RobotState,
 
 from labware_model.holders import GRIPPER, Nest
 from labware_model.holders import HotelSlot as Slot
-from labware_model.workcell import StationDescription, WorkcellDescription
-from tiago_sim.sequencer.plans import Expect, TaskRefused, get_plan, put_plan, retreat_steps
+from labware_model.workcell import STOCK_SENSORS, StationDescription, WorkcellDescription
+from tiago_sim.sequencer.plans import Expect, TaskRefused, get_plan, is_inspection, put_plan, retreat_steps
 from tiago_sim.sequencer.postconditions import topic_of, unmet
 
 WORKCELL = WorkcellDescription((StationDescription("station_a", 2, "station_a_work"),), 2, (), "dock")
@@ -53,6 +54,63 @@ def goal() -> SimpleNamespace:
 
 def checks(plan: list) -> list[tuple[str, object, str]]:
     return [(step.phase, step.post.holder, step.post.code) for step in plan if step.post is not None]
+
+
+STOCK = replace(WORKCELL, sensors=STOCK_SENSORS)
+
+
+def book(**plates: str):
+    """An inventory lookup recording plates at "slot1", "slot2", "a1" (the name, or "" unnamed)."""
+    places = {Slot(1): plates.get("slot1"), Slot(2): plates.get("slot2"), A1: plates.get("a1")}
+    return lambda holder: places.get(holder)
+
+
+def test_without_sensors_a_get_is_checked_by_the_fingers_alone() -> None:
+    """No nest sensor: the grasp finds out whether the source holds a plate; no hotel sensor: the
+    plate held down in the pocket until the release is the check of the stowing."""
+    plan = get_plan(goal(), STOCK, robot(hotel={}), None, "right", book())
+    assert [step.phase for step in plan if step.expect_holding] == ["grasp"]
+    assert checks(plan) == [
+        ("lifting", GRIPPER, ErrorCodes.PLATE_SLIPPED),
+        ("into hotel", GRIPPER, ErrorCodes.PLATE_SLIPPED),
+    ]
+    assert not any(is_inspection(step) for step in plan)
+
+
+def test_without_sensors_a_put_looks_into_the_nest_before_and_after() -> None:
+    plan = put_plan(goal(), STOCK, robot(hotel={}), None, "right", book(slot1="P1"))
+    assert checks(plan) == [
+        ("checking the nest is free", A1, ErrorCodes.NEST_OCCUPIED),
+        ("lifting", GRIPPER, ErrorCodes.PLATE_SLIPPED),
+        ("placing", GRIPPER, ErrorCodes.PLATE_SLIPPED),
+        ("checking the plate is in the nest", A1, ErrorCodes.PLACE_FAILED),
+    ]
+    looks = [step for step in plan if is_inspection(step)]
+    assert [step.post.empty for step in looks] == [True, False]
+    assert plan[1] is looks[0], "the nest is looked into before the arm moves"
+    assert plan[-1] is looks[1] and plan[-2].goal["motion_name"] == "Tuck", "and once the arm is out of view"
+
+
+@pytest.mark.parametrize(
+    ("make_plan", "plates", "code", "words"),
+    [
+        (
+            get_plan,
+            {"slot1": "P9"},
+            ErrorCodes.SLOT_OCCUPIED,
+            "hotel slot 1 already holds P9 (by the inventory",
+        ),
+        (put_plan, {}, ErrorCodes.SLOT_EMPTY, "hotel slot 1 holds no plate (by the inventory"),
+        (put_plan, {"slot1": "P1", "a1": ""}, ErrorCodes.NEST_OCCUPIED, "holds a plate (by the inventory"),
+    ],
+)
+def test_without_sensors_the_inventory_stands_in_before_anything_moves(
+    make_plan, plates, code, words
+) -> None:
+    with pytest.raises(TaskRefused) as refused:
+        make_plan(goal(), STOCK, robot(hotel={}), None, "right", book(**plates))
+    assert refused.value.code == code
+    assert words in refused.value.message
 
 
 def test_get_checks_the_gripper_while_carrying_and_the_hotel_slot_after_stowing() -> None:

@@ -27,7 +27,7 @@ from std_srvs.srv import Trigger
 
 from robot_port.tiago_interfaces import CAMERA_IMAGE as CAMERA_IMAGE_TOPIC
 from robot_port.tiago_interfaces import CAMERA_INFO as CAMERA_INFO_TOPIC
-from tests.helpers.ros_processes import RosCaller, running
+from tests.helpers.ros_processes import RosCaller, robot_side
 from tests.helpers.sim_parameters import parameter_request
 from tiago_twin.lab_reset import RESET_SERVICE
 
@@ -38,26 +38,14 @@ TASK_TIMEOUT_S = 240.0
 @pytest.fixture(scope="module")
 def robot(tmp_path_factory: pytest.TempPathFactory) -> Iterator[RosCaller]:
     logs = tmp_path_factory.mktemp("ros_logs")
-    with (
-        running("tiago_twin", "--seed", "7", log_path=logs / "sim_node.log") as sim,
-        running("tiago_sim.sequencer", log_path=logs / "sequencer.log") as sequencer,
-    ):
-        caller = RosCaller("test_ros_transfer")
-        try:
-            caller.subscribe(RobotState, "/robot_state")
-            caller.subscribe(StationStates, "/station_states")
-            caller.subscribe(JointState, "/joint_states")
-            caller.action_client(GetLabware, "/get_labware", timeout_s=60.0)
-            caller.action_client(PutLabware, "/put_labware", timeout_s=60.0)
-            caller.wait_for(lambda: len(caller.latest) == 3, 30.0, "robot and station topics")
-            yield caller
-        finally:
-            caller.close()
-            for process, name in ((sim, "sim_node"), (sequencer, "sequencer")):
-                assert process.poll() is None, f"{name} died early; see {logs / (name + '.log')}"
-    for process, name in ((sim, "sim_node"), (sequencer, "sequencer")):
-        assert process.returncode == 0, f"{name} did not exit cleanly on SIGTERM: {process.returncode}"
-        assert "Traceback" not in (logs / f"{name}.log").read_text(), f"{name} logged a traceback"
+    with robot_side(logs, "test_ros_transfer", "--seed", "7") as caller:
+        caller.subscribe(RobotState, "/robot_state")
+        caller.subscribe(StationStates, "/station_states")
+        caller.subscribe(JointState, "/joint_states")
+        caller.action_client(GetLabware, "/get_labware", timeout_s=60.0)
+        caller.action_client(PutLabware, "/put_labware", timeout_s=60.0)
+        caller.wait_for(lambda: len(caller.latest) == 3, 30.0, "robot and station topics")
+        yield caller
 
 
 @pytest.fixture(autouse=True)
