@@ -12,8 +12,8 @@ plate), not from a contact sensor. Docking is the lab's: Nav2's docking server (
 lab's dock; "" for its only one), and whether the robot is docked is the battery charging, as
 Nav2's charging dock reads it from `/battery_state`.
 
-The names and types are robot_port.tiago_interfaces'. Localisation's correction comes from
-`/map_to_odom` (the simulator's topic for what a robot's `/tf` carries as map -> odom).
+The names and types are robot_port.tiago_interfaces'. Localisation's correction is the map -> odom
+transform on the robot's `/tf`, as AMCL sends it.
 
 Threads: the node's callbacks on its executor's threads (the caller spins the node, with threads to
 spare for the goals' answers); every port method on any thread.
@@ -29,16 +29,17 @@ from typing import Any
 
 import numpy as np
 from control_msgs.action import FollowJointTrajectory
-from geometry_msgs.msg import PoseStamped, TransformStamped, Twist
+from geometry_msgs.msg import PoseStamped, Twist
 from nav2_msgs.action import DockRobot, NavigateToPose, UndockRobot
 from nav_msgs.msg import Odometry
 from rclpy.action import ActionClient
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import BatteryState, CameraInfo, Image, JointState
 from sensor_msgs.msg import LaserScan as LaserScanMsg
+from tf2_msgs.msg import TFMessage
 from trajectory_msgs.msg import JointTrajectoryPoint
 
 from robot_port.execution import Execution
@@ -54,6 +55,7 @@ from robot_port.tiago_interfaces import (
     LASER,
     NAVIGATE_TO_POSE,
     ODOMETRY,
+    TF,
     UNDOCK_ROBOT,
     controller_action,
 )
@@ -68,7 +70,7 @@ from tiago_ros_hardware.trajectory_goals import controller_goals, duration_msg
 
 READING_TIMEOUT_S = 30.0
 """Wall seconds a reading may wait for its topic before the robot counts as gone."""
-CORRECTION_TOPIC = "/map_to_odom"
+MAP_FRAME, ODOM_FRAME = "map", "odom"
 NAVIGATION_SPEED_MPS = 0.5  # for the time-left estimate of a navigation goal only
 DOCKING_S = 8.0  # for the time-left estimate of docking and undocking only
 
@@ -101,13 +103,10 @@ class RosHardware:
         self.infos = TopicHistory(CAMERA_INFO)
         self.battery = TopicHistory(BATTERY_STATE)
         reliable = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
-        latched = QoSProfile(
-            depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
-        )
         self._subscribe(Clock, "/clock", self._on_clock, reliable)
         self._subscribe(JointState, JOINT_STATES, self._on_joints, reliable)
         self._subscribe(Odometry, ODOMETRY, self._on_odometry, reliable)
-        self._subscribe(TransformStamped, CORRECTION_TOPIC, self._on_correction, latched)
+        self._subscribe(TFMessage, TF, self._on_tf, reliable)
         self._subscribe(BatteryState, BATTERY_STATE, self.battery.add, reliable)
         self._settled = {"joints": 0, "odom": 0, "battery": 0}  # counts after which readings show it at rest
         self.cmd_vel = node.create_publisher(Twist, CMD_VEL, reliable)
@@ -140,9 +139,12 @@ class RosHardware:
         twist = message.twist.twist
         self.odom.add((planar, (float(twist.linear.x), float(twist.angular.z))), stamp_seconds(message))
 
-    def _on_correction(self, message: TransformStamped) -> None:
-        t = message.transform
-        self._correction = (float(t.translation.x), float(t.translation.y), yaw_of(t.rotation))
+    def _on_tf(self, message: TFMessage) -> None:
+        """Localisation's map -> odom, from the robot's /tf (other transforms are not needed)."""
+        for stamped in message.transforms:
+            if (stamped.header.frame_id, stamped.child_frame_id) == (MAP_FRAME, ODOM_FRAME):
+                t = stamped.transform
+                self._correction = (float(t.translation.x), float(t.translation.y), yaw_of(t.rotation))
 
     # -- clock and readings --------------------------------------------------------------------
     def now(self) -> float:

@@ -47,8 +47,27 @@ OPEN_FINGER_REACH = rm.FINGER_MOUNT_OFFSET + rm.FINGER_TRAVEL + rm.PAD_THICKNESS
 BENCH_EDGE_MARGIN = 0.02
 BENCH_FRONT_X = WORKING_CLEARANCE - OPEN_FINGER_REACH - BENCH_EDGE_MARGIN
 
+# Fingers closed on a plate stand its short side apart; a plate grasped tilted by more than about 28
+# deg about its long side (the pads on its edges, seen once: fingers 75 mm apart on an 85.5 mm plate,
+# which then fell over in the hotel) stands more than this closer or wider.
+GRASP_WIDTH_TOLERANCE_M = 0.004
+
 # Half-turn about the grasp x axis: the same top-down grasp with the fingers swapped.
 FLIP_ABOUT_APPROACH = make_transform(rotation=np.diag([1.0, -1.0, -1.0]))
+
+
+def grasp_width_problem(opening_m: float, plate_widths: tuple[float, ...]) -> str:
+    """Why fingers closed `opening_m` apart do not hold one of the lab's plates flat ("" if they
+    do, or when no widths are known): a plate held flat spans its short side."""
+    if not plate_widths:
+        return ""
+    nearest = min(plate_widths, key=lambda width: abs(width - opening_m))
+    if abs(nearest - opening_m) <= GRASP_WIDTH_TOLERANCE_M:
+        return ""
+    return (
+        f"the fingers closed {1000 * opening_m:.1f} mm apart, and no plate of this lab is that wide "
+        f"(nearest {1000 * nearest:.1f} mm): the plate is not held flat"
+    )
 
 
 def move_joints(targets: dict[str, float], speed_scale: float = 1.0) -> Callable[[RobotHardware], Execution]:
@@ -69,6 +88,7 @@ class RobotBehaviours:
         motions: MotionLibrary,
         speed_scale: Callable[[], float],
         seed: int | None = None,
+        plate_widths: tuple[float, ...] = (),
     ) -> None:
         self.poi_pose = poi_pose
         self.poi_names = poi_names
@@ -76,6 +96,7 @@ class RobotBehaviours:
         self.hotel_slots = hotel_slots
         self.motions = motions
         self.speed_scale = speed_scale
+        self.plate_widths = plate_widths  # the short sides of the lab's plate types: what a grasp spans
         self.planning = ArmPlanning(seed)
         self.grasp_flipped: dict[str, bool] = {}  # per arm: twin of the top-down grasp last used
         self.holding: dict[str, bool] = {}  # per arm: the last gripper command closed on a plate
@@ -373,4 +394,8 @@ class RobotBehaviours:
         execution = run.follow(lambda hardware: hardware.gripper(arm, close))
         holding = bool(execution.result.get("holding", False))
         self.holding[arm] = close and holding
-        return {"holding": holding, "opening_m": float(execution.result.get("opening_m", math.nan))}
+        opening = float(execution.result.get("opening_m", math.nan))
+        problem = grasp_width_problem(opening, self.plate_widths) if close and holding else ""
+        if problem:
+            raise ActionAbort(ErrorCodes.GRASP_FAILED, problem)
+        return {"holding": holding, "opening_m": opening}

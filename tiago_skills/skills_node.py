@@ -60,6 +60,7 @@ class RobotSkills:
             motions=motions,
             speed_scale=lambda: float(node.get_parameter("speed_scale").value),
             seed=seed,
+            plate_widths=tuple(sorted({t.width for t in world.labware_types.values()})),
         )
         self.marker_motion = MarkerMotionBehaviour(world, self.behaviours, motions.hotel)
         self.actions = RobotActionServers(

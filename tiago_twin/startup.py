@@ -174,7 +174,9 @@ def main(argv: list[str] | None = None) -> int:
         if args.robot_interfaces:  # kept with the node: its action servers live as long
             from tiago_sim.sim_node.robot_interfaces import RobotInterfaces
 
-            sim_node.robot_interfaces = RobotInterfaces(node, believed, sim_thread, navigation)
+            sim_node.robot_interfaces = RobotInterfaces(
+                node, believed, sim_thread, navigation, sim_node.publishers.localisation_topics
+            )
         lab_reset = LabReset(node, sim_thread, skills.actions.slot)
         lab_reset.hooks += [sim_node.forget_the_old_lab, skills.forget]
         log.info("sim node ready: world %s, %d stations", world.source, len(world.stations))

@@ -22,7 +22,7 @@ from typing import Any
 import rclpy
 from rclpy.action import ActionClient
 from rclpy.executors import SingleThreadedExecutor
-from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 from ros_bridge.actions import cancel_nobodys_goal
 
@@ -100,9 +100,11 @@ class RosCaller:
                 raise TimeoutError(f"timed out waiting for {what}")
             self.executor.spin_once(timeout_sec=0.05)
 
-    def subscribe(self, message_type: Any, topic: str) -> Any:
-        """Keep the latest message of `topic` in `latest`; returns the subscription (to destroy)."""
-        qos = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
+    def subscribe(self, message_type: Any, topic: str, latched: bool = False) -> Any:
+        """Keep the latest message of `topic` in `latest` (`latched`: a transient-local topic's last
+        message too); returns the subscription (to destroy)."""
+        durability = DurabilityPolicy.TRANSIENT_LOCAL if latched else DurabilityPolicy.VOLATILE
+        qos = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE, durability=durability)
         return self.node.create_subscription(
             message_type, topic, lambda msg: self.latest.__setitem__(topic, msg), qos
         )

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import threading
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -18,6 +19,7 @@ import numpy as np
 import pytest
 import rclpy
 from geometry_msgs.msg import Pose2D as Pose2DMsg
+from geometry_msgs.msg import TransformStamped
 from rclpy.executors import MultiThreadedExecutor
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
@@ -27,6 +29,7 @@ from robot_port.trajectory_timing import profiled_path
 from robot_port.types import JointTrajectory
 from tests.helpers.ros_processes import RosCaller, running
 from tiago_description import robot_model as rm
+from tiago_description import transforms as tf
 from tiago_description.joint_limits import velocity_limits
 from tiago_ros_hardware.hardware import RosHardware
 
@@ -172,3 +175,22 @@ def test_the_base_undocks_drives_navigates_and_docks(robot: tuple[RosHardware, R
     docking = finished(hardware.dock())
     assert docking.success, docking.message
     assert hardware.is_docked()
+
+
+def test_the_pose_estimate_takes_localisations_correction_from_tf(
+    robot: tuple[RosHardware, RosCaller],
+) -> None:
+    """The believed pose is odometry corrected by the map -> odom transform on /tf, as AMCL sends it:
+    the same correction the simulator's localisation publishes on its own /map_to_odom."""
+    hardware, caller = robot
+    caller.subscribe(TransformStamped, "/map_to_odom", latched=True)
+    caller.wait_for(lambda: "/map_to_odom" in caller.latest, 30.0, "a localisation correction")
+    t = caller.latest["/map_to_odom"].transform
+    correction = (t.translation.x, t.translation.y, 2 * math.atan2(t.rotation.z, t.rotation.w))
+    assert any(abs(v) > 1e-9 for v in correction), "an identity correction would prove nothing"
+    deadline = time.monotonic() + 10.0
+    while time.monotonic() < deadline and not np.allclose(hardware._correction, correction, atol=1e-9):
+        time.sleep(0.1)  # /tf re-sends it every 0.5 s
+    assert np.allclose(hardware._correction, correction, atol=1e-9), (hardware._correction, correction)
+    expected = tf.compose_planar(correction, hardware.odometry())
+    assert np.allclose(hardware.pose_estimate(), expected, atol=1e-3)

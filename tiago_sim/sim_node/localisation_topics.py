@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import array
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -100,6 +101,8 @@ class LocalisationTopics:
         self.correction_pub = node.create_publisher(TransformStamped, CORRECTION_TOPIC, latched)
         self._scan: LaserReading | None = None
         self._localised: Localised | None = None
+        # Also told each new correction: the robot's own /tf, when the simulator serves it (tf_topic).
+        self.correction_listeners: list[Callable[[TransformStamped], None]] = []
 
     def scans_wanted(self) -> bool:
         return self.scan_pub.get_subscription_count() > 0
@@ -111,4 +114,7 @@ class LocalisationTopics:
         if view.localised is not None and view.localised is not self._localised:
             self._localised = view.localised
             self.pose_pub.publish(pose_message(view.localised))
-            self.correction_pub.publish(correction_message(view.localised))
+            correction = correction_message(view.localised)
+            self.correction_pub.publish(correction)
+            for listener in self.correction_listeners:
+                listener(correction)

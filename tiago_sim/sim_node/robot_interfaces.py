@@ -4,7 +4,8 @@ Why: the skills reach the twin through the hardware port in-process, the fast wa
 software written against a real robot (and the port's ROS adapter) speaks the robot's interfaces
 instead (robot_port.tiago_interfaces). These are the ones the sensor topics do not already give:
 the controllers' actions (controllers), the base's velocity input, Nav2's navigation goal and the
-docking a lab adds (base_interfaces). Off by default: their endpoints cost discovery and CPU in every trial.
+docking a lab adds (base_interfaces), localisation's map -> odom on /tf (tf_topic). Off by
+default: their endpoints cost discovery and CPU in every trial.
 """
 
 from __future__ import annotations
@@ -16,8 +17,10 @@ from rclpy.node import Node
 from lab_description.world import World
 from tiago_sim.sim_node.base_interfaces import BaseVelocityInput, DockingServers, NavigateToPoseServer
 from tiago_sim.sim_node.controllers import TrajectoryControllers
+from tiago_sim.sim_node.localisation_topics import LocalisationTopics
 from tiago_sim.sim_node.navigation import Navigation
 from tiago_sim.sim_node.sim_thread import SimThread
+from tiago_sim.sim_node.tf_topic import MapToOdomBroadcast
 
 log = logging.getLogger(__name__)
 
@@ -25,8 +28,17 @@ log = logging.getLogger(__name__)
 class RobotInterfaces:
     """The controllers, the velocity input and the navigation goal, on the sim node's node."""
 
-    def __init__(self, node: Node, world: World, sim_thread: SimThread, navigation: Navigation) -> None:
+    def __init__(
+        self,
+        node: Node,
+        world: World,
+        sim_thread: SimThread,
+        navigation: Navigation,
+        localisation_topics: LocalisationTopics,
+    ) -> None:
         self.controllers = TrajectoryControllers(node, sim_thread)
+        self.tf = MapToOdomBroadcast(node)
+        localisation_topics.correction_listeners.append(self.tf.update)
         self.velocity = BaseVelocityInput(node, sim_thread)
         self.navigation = NavigateToPoseServer(node, navigation, sim_thread)
         self.docking = DockingServers(node, world, navigation, sim_thread)
