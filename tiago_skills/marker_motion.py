@@ -169,7 +169,11 @@ class MarkerMotionBehaviour:
                 ErrorCodes.NEST_NOT_SEEN,
                 f"the head camera cannot see into nest {sub_position} of {station.name}: {view.reason}",
             )
-        return {"marker_in_base": pose_msg(sighting.T_base_marker), "nest_occupied": bool(view.occupied)}
+        return {
+            "marker_in_base": pose_msg(sighting.T_base_marker),
+            "nest_occupied": bool(view.occupied),
+            "plate_seated": view.seated,
+        }
 
     def _view(self, run: GoalRun, T_base_site: np.ndarray) -> NestView:
         run.feedback(max(run.progress, 0.1), "looking into the nest", 0.0, force=True)

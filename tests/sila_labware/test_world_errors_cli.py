@@ -69,7 +69,7 @@ def test_demo_and_world_check_list_every_problem_in_the_same_words(tmp_path: Pat
     world = bad_world(tmp_path, three_problems)
     expected = [
         f"{world}: furniture: unknown key; expected one of dock, floor_size, labware_types, name, "
-        "obstacles, plates, pois, robot, stations",
+        "obstacles, plates, pois, robot, sensors, stations",
         f"{world}: stations[0].nests.spacng: unknown key; did you mean 'spacing'?",
         f"{world}: stations[1].marker.id: marker id 3 already used",
     ]

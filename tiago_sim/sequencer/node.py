@@ -328,9 +328,11 @@ class Sequencer:
         occupied = bool(sub_result.nest_occupied)
         if not expect.empty:  # a look after the place: a plate there is the task's (a look before is not)
             self.camera_nests[expect.holder] = occupied
-        if occupied == (not expect.empty):
+        if expect.empty and not occupied or not expect.empty and sub_result.plate_seated:
             return
         seen = "a plate" if occupied else "no plate"
+        if occupied and not expect.empty:
+            seen = "a plate, but not seated (not level at a plate's height)"
         raise StepFailed(
             expect.code, f"after {step.phase}: the head camera sees {seen} in nest {expect.holder}"
         )

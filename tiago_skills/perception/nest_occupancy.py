@@ -9,7 +9,10 @@ Method: the depth pixels are back-projected into the nest's site frame (as the s
 gave it: z up from the floor a seated plate rests on). Those whose x and y lie inside the smallest
 plate's footprint, shrunk by ``FOOTPRINT_MARGIN_M`` so that the nest's rims and a plate's edges stay
 out, are the nest's floor or a plate's top. Their median height decides: above half the lowest
-plate's height is a plate, below it the empty floor. Too few such points (the nest out of the image,
+plate's height is a plate, below it the empty floor. A plate is seated when its top is level (a plane
+fitted to those pixels tilts less than ``MAX_SEATED_TILT_DEG``) at a plate type's height: one left
+on a lead-in's rim stands up to 6 mm up at one end, 3 to 4 deg tilted, which is still a plate in
+the nest for a check that it is free, but not a plate placed. Too few such points (the nest out of the image,
 hidden behind the arm or the marker's board) or a median well above any plate (something else on
 it) is no answer: the caller reports that it could not see, never a guess.
 
@@ -30,6 +33,11 @@ FOOTPRINT_MARGIN_M = 0.015  # kept clear of the footprint's edges (rims, a plate
 MIN_POINTS = 300  # about a seventh of the shrunk footprint's pixels at 0.8 m
 BELOW_FLOOR_M = 0.02  # points lower than this under the nest's floor are not on it (a hole, noise)
 ABOVE_PLATES_M = 0.03  # a median this far above the tallest plate's top is something else
+# A seated plate's top: level within this (the camera's calibration tilts what it sees by a few
+# tenths of a degree), at a plate type's height within SEATED_HEIGHT_M (the bench height's and the
+# depth bias's errors, at three sigma).
+MAX_SEATED_TILT_DEG = 1.5
+SEATED_HEIGHT_M = 0.004
 
 
 @dataclass(frozen=True)
@@ -38,8 +46,10 @@ class NestView:
 
     occupied: bool | None
     height_m: float  # median height of the footprint's points above the nest's floor (nan: none)
+    tilt_deg: float  # of the plane fitted to them (nan: none)
     points: int  # depth pixels inside the footprint
     reason: str  # why there is no answer, or what was seen
+    seated: bool = False  # a plate lies level at a plate type's height
 
     @property
     def seen(self) -> bool:
@@ -53,7 +63,7 @@ def view_nest(
     plate_sizes: Iterable[tuple[float, float, float]],
 ) -> NestView:
     """Whether the nest whose site frame the camera sees at `T_site_optical` holds a plate of one
-    of the lab's types (`plate_sizes`: length, width, height in m)."""
+    of the lab's types (`plate_sizes`: length, width, height in m), and whether it is seated."""
     sizes = np.array(list(plate_sizes), dtype=float).reshape(-1, 3)
     if not len(sizes):
         raise ValueError("no plate types: nothing to look for")
@@ -62,17 +72,25 @@ def view_nest(
     lowest, tallest = float(sizes[:, 2].min()), float(sizes[:, 2].max())
     points = site_points(depth_m, intrinsics, T_site_optical)
     inside = (np.abs(points[:, 0]) < half_length) & (np.abs(points[:, 1]) < half_width)
-    heights = points[inside, 2]
-    heights = heights[heights > -BELOW_FLOOR_M]
-    if heights.size < MIN_POINTS:
-        return NestView(
-            None, float("nan"), int(heights.size), f"only {heights.size} depth pixels in the nest"
-        )
-    median = float(np.median(heights))
+    footprint = points[inside & (points[:, 2] > -BELOW_FLOOR_M)]
+    count = len(footprint)
+    if count < MIN_POINTS:
+        return NestView(None, float("nan"), float("nan"), count, f"only {count} depth pixels in the nest")
+    median = float(np.median(footprint[:, 2]))
+    tilt = _tilt_deg(footprint)
     if median > tallest + ABOVE_PLATES_M:
         reason = f"something {1000 * median:.0f} mm above the nest's floor hides it"
-        return NestView(None, median, int(heights.size), reason)
+        return NestView(None, median, tilt, count, reason)
     occupied = bool(median > lowest / 2)
-    what = "a plate's top" if occupied else "the empty floor"
-    reason = f"{what} at {1000 * median:.1f} mm ({heights.size} pixels)"
-    return NestView(occupied, median, int(heights.size), reason)
+    at_height = bool(np.min(np.abs(sizes[:, 2] - median)) < SEATED_HEIGHT_M)
+    seated = occupied and at_height and tilt < MAX_SEATED_TILT_DEG
+    what = ("a seated plate" if seated else "a plate, not seated,") if occupied else "the empty floor"
+    reason = f"{what} at {1000 * median:.1f} mm, tilted {tilt:.1f} deg ({count} pixels)"
+    return NestView(occupied, median, tilt, count, reason, seated)
+
+
+def _tilt_deg(points: np.ndarray) -> float:
+    """The tilt of the plane z = a x + b y + c fitted to `points` (least squares)."""
+    design = np.column_stack([points[:, 0], points[:, 1], np.ones(len(points))])
+    (a, b, _c), *_ = np.linalg.lstsq(design, points[:, 2], rcond=None)
+    return float(np.degrees(np.arctan(np.hypot(a, b))))

@@ -49,7 +49,7 @@ def test_an_invalid_world_exits_1_with_one_line_per_problem(tmp_path: Path, caps
     assert captured.out == "" and not picture.exists()
     assert captured.err.splitlines() == [
         f"{path}: furniture: unknown key; expected one of dock, floor_size, labware_types, name, "
-        "obstacles, plates, pois, robot, stations",
+        "obstacles, plates, pois, robot, sensors, stations",
         f"{path}: statoins: unknown key; did you mean 'stations'?",
     ]
 

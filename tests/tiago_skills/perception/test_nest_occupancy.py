@@ -72,22 +72,24 @@ def _view(depth: np.ndarray, T_world_optical: np.ndarray, belief_error=(0.004, -
 
 def test_an_empty_nest_reads_empty():
     view = _view(*_render(None))
-    assert view.occupied is False, view.reason
+    assert view.occupied is False and not view.seated, view.reason
     assert abs(view.height_m) < 0.004
 
 
 @pytest.mark.parametrize("plate", [PLATE, LOW_PLATE], ids=["sbs", "low"])
 def test_a_seated_plate_reads_as_a_plate(plate):
     view = _view(*_render(plate))
-    assert view.occupied is True, view.reason
+    assert view.occupied is True and view.seated, view.reason
     assert abs(view.height_m - plate.height) < 0.004
 
 
-def test_a_plate_on_the_rim_reads_as_a_plate():
-    """A plate left on a lead-in is there all the same: the place failed in another way, which the
-    physics' own check judges; the camera must not call the nest free for another plate."""
-    view = _view(*_render(PLATE, plate_pose=(0.01, 0.0, RIM, np.radians(3.0))))
-    assert view.occupied is True, view.reason
+@pytest.mark.parametrize("tilt_deg", [2.7, 4.0])
+def test_a_plate_on_the_rim_is_a_plate_there_but_not_seated(tilt_deg: float):
+    """A plate left with one end on a lead-in's rim is there all the same: the nest is not free for
+    another plate; but it is not placed."""
+    end_up = (PLATE.length / 2) * np.sin(np.radians(tilt_deg))
+    view = _view(*_render(PLATE, plate_pose=(0.0, 0.0, end_up / 2, np.radians(tilt_deg))))
+    assert view.occupied is True and not view.seated, view.reason
 
 
 def test_a_nest_hidden_by_the_arm_gives_no_answer():
