@@ -70,6 +70,14 @@ class MarkerSighting:
     joints: dict[str, float] = field(default_factory=dict)  # readings taken with the image
 
 
+def same_place(then: tuple[float, float, float], now: tuple[float, float, float]) -> bool:
+    """Whether the base stands where odometry put it `then` (a sighting from there still holds)."""
+    moved = math.hypot(now[0] - then[0], now[1] - then[1])
+    return (
+        moved < SAME_BASE_POSITION_M and abs(math.remainder(now[2] - then[2], math.tau)) < SAME_BASE_YAW_RAD
+    )
+
+
 def pose_msg(transform: np.ndarray) -> Pose:
     position, quat = tf.to_pose(transform)
     pose = Pose()
@@ -90,6 +98,8 @@ class MarkerMotionBehaviour:
         self.kinematics = RobotKinematics()
         self._lock = threading.Lock()
         self.last_sighting: MarkerSighting | None = None
+        # (station, nest) -> (odometry, height) of the floor the last look saw empty in that nest
+        self.floors_seen: dict[tuple[str, int], tuple[tuple[float, float, float], float]] = {}
 
     def look(self, run: GoalRun, station_name: str) -> MarkerSighting:
         """Image + joints at one instant, marker detection, marker pose in base_footprint."""
@@ -123,10 +133,8 @@ class MarkerMotionBehaviour:
         sighting = self.last_sighting
         if sighting is None or sighting.station != station_name:
             return None
-        x, y, yaw = run.read(lambda hardware: tuple(hardware.odometry()))
-        moved = math.hypot(x - sighting.odometry[0], y - sighting.odometry[1])
-        turned = abs(math.remainder(yaw - sighting.odometry[2], math.tau))
-        return sighting if moved < SAME_BASE_POSITION_M and turned < SAME_BASE_YAW_RAD else None
+        odometry = run.read(lambda hardware: tuple(hardware.odometry()))
+        return sighting if same_place(sighting.odometry, odometry) else None
 
     def _sighting_here(self, run: GoalRun, station: Any) -> MarkerSighting:
         """The marker's sighting from where the base stands: the cached one, else a search from
@@ -149,7 +157,10 @@ class MarkerMotionBehaviour:
         T_marker_site = station.T_marker_site(sub_position)
         height = float((station.T_world_marker() @ T_marker_site)[2, 3])
         T_base_site = nest_in_base(sighting.T_base_marker, station.T_table_marker(), T_marker_site, height)
-        view = self._view(run, T_base_site)
+        key, odometry = (station.name, sub_position), run.read(lambda hardware: tuple(hardware.odometry()))
+        floor = self.floors_seen.get(key)
+        floor_m = floor[1] if floor is not None and same_place(floor[0], odometry) else None
+        view = self._view(run, T_base_site, floor_m)
         if not view.seen:
             joints = run.read(lambda hardware: dict(hardware.joint_positions()))
             back = {name: joints[name] for name in HEAD_JOINTS}
@@ -161,9 +172,11 @@ class MarkerMotionBehaviour:
                 view.reason,
             )
             run.follow(move_joints(aim), span=(0.2, 0.5))
-            view = self._view(run, T_base_site)
+            view = self._view(run, T_base_site, floor_m)
             run.follow(move_joints(back), span=(0.6, 1.0))
         log.info("nest %d of %s: %s", sub_position, station.name, view.reason)
+        if view.occupied is False:
+            self.floors_seen[key] = (odometry, view.height_m)
         if not view.seen:
             raise ActionAbort(
                 ErrorCodes.NEST_NOT_SEEN,
@@ -175,14 +188,14 @@ class MarkerMotionBehaviour:
             "plate_seated": view.seated,
         }
 
-    def _view(self, run: GoalRun, T_base_site: np.ndarray) -> NestView:
+    def _view(self, run: GoalRun, T_base_site: np.ndarray, floor_m: float | None) -> NestView:
         run.feedback(max(run.progress, 0.1), "looking into the nest", 0.0, force=True)
         frame = run.read(lambda hardware: hardware.capture_head_camera())
         with self._lock:
             T_base_optical = self.kinematics.forward(frame.joints, CAMERA_FRAME)
         T_site_optical = tf.invert(T_base_site) @ T_base_optical
         sizes = [(t.length, t.width, t.height) for t in self.world.labware_types.values()]
-        return view_nest(frame.depth, frame.intrinsics, T_site_optical, sizes)
+        return view_nest(frame.depth, frame.intrinsics, T_site_optical, sizes, floor_m)
 
     def _centred_on_plate(
         self, run: GoalRun, arm: str, T_base_site: np.ndarray, sighting: MarkerSighting

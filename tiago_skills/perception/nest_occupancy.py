@@ -10,11 +10,15 @@ gave it: z up from the floor a seated plate rests on). Those whose x and y lie i
 plate's footprint, shrunk by ``FOOTPRINT_MARGIN_M`` so that the nest's rims and a plate's edges stay
 out, are the nest's floor or a plate's top. Their median height decides: above half the lowest
 plate's height is a plate, below it the empty floor. A plate is seated when its top is level (a plane
-fitted to those pixels tilts less than ``MAX_SEATED_TILT_DEG``) at a plate type's height: one left
-on a lead-in's rim stands up to 6 mm up at one end, 3 to 4 deg tilted, which is still a plate in
-the nest for a check that it is free, but not a plate placed. Too few such points (the nest out of the image,
-hidden behind the arm or the marker's board) or a median well above any plate (something else on
-it) is no answer: the caller reports that it could not see, never a guess.
+fitted to those pixels tilts less than ``MAX_SEATED_TILT_DEG``) and, where the same nest's empty
+floor was seen from the same place before, a plate type's height above that floor: one left on a
+lead-in's rim stands up to 6 mm up at one end, 3 to 4 deg tilted, which is still a plate in the
+nest for a check that it is free, but not a plate placed. Heights are compared with a floor seen,
+not with the one the robot believes: the camera's calibration and depth bias put the whole view a
+few millimetres up or down (4.6 mm seen over a random layout), the same in both looks. Too few such
+points (the nest out of the image, hidden behind the arm or the marker's board) or a median well
+above any plate (something else on it) is no answer: the caller reports that it could not see,
+never a guess.
 
 Pure functions on arrays; safe on any thread.
 """
@@ -34,8 +38,7 @@ MIN_POINTS = 300  # about a seventh of the shrunk footprint's pixels at 0.8 m
 BELOW_FLOOR_M = 0.02  # points lower than this under the nest's floor are not on it (a hole, noise)
 ABOVE_PLATES_M = 0.03  # a median this far above the tallest plate's top is something else
 # A seated plate's top: level within this (the camera's calibration tilts what it sees by a few
-# tenths of a degree), at a plate type's height within SEATED_HEIGHT_M (the bench height's and the
-# depth bias's errors, at three sigma).
+# tenths of a degree), at a plate type's height above the floor seen within SEATED_HEIGHT_M.
 MAX_SEATED_TILT_DEG = 1.5
 SEATED_HEIGHT_M = 0.004
 
@@ -61,9 +64,11 @@ def view_nest(
     intrinsics: CameraIntrinsics,
     T_site_optical: np.ndarray,
     plate_sizes: Iterable[tuple[float, float, float]],
+    floor_m: float | None = None,
 ) -> NestView:
     """Whether the nest whose site frame the camera sees at `T_site_optical` holds a plate of one
-    of the lab's types (`plate_sizes`: length, width, height in m), and whether it is seated."""
+    of the lab's types (`plate_sizes`: length, width, height in m), and whether it is seated;
+    `floor_m`: the height this nest's empty floor was seen at from the same place, if it was."""
     sizes = np.array(list(plate_sizes), dtype=float).reshape(-1, 3)
     if not len(sizes):
         raise ValueError("no plate types: nothing to look for")
@@ -82,7 +87,8 @@ def view_nest(
         reason = f"something {1000 * median:.0f} mm above the nest's floor hides it"
         return NestView(None, median, tilt, count, reason)
     occupied = bool(median > lowest / 2)
-    at_height = bool(np.min(np.abs(sizes[:, 2] - median)) < SEATED_HEIGHT_M)
+    above_floor = median - (0.0 if floor_m is None else floor_m)
+    at_height = floor_m is None or bool(np.min(np.abs(sizes[:, 2] - above_floor)) < SEATED_HEIGHT_M)
     seated = occupied and at_height and tilt < MAX_SEATED_TILT_DEG
     what = ("a seated plate" if seated else "a plate, not seated,") if occupied else "the empty floor"
     reason = f"{what} at {1000 * median:.1f} mm, tilted {tilt:.1f} deg ({count} pixels)"

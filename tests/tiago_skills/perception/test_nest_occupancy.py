@@ -102,3 +102,25 @@ def test_a_nest_out_of_the_image_gives_no_answer():
     view = _view(*_render(None, look_away=True))
     assert view.occupied is None
     assert "depth pixels" in view.reason
+
+
+def test_heights_count_from_the_floor_seen_before_not_the_one_believed():
+    """The view stands 5 mm off (the camera's calibration): the floor seen empty before the place is
+    the reference. A plate seated reads seated; one lying level on top of the rims, 6 mm up, not.
+    (Whether the nest is empty is read against the floor believed: with SBS plates only, half
+    their 14 mm leaves room for such a view; a 6.5 mm plate would not.)"""
+    belief = (0.004, -0.003, -0.005)
+    sizes = [(PLATE.length, PLATE.width, PLATE.height)]
+    depth, T_world_optical = _render(None)
+    T_site_optical = tf.invert(T_WORLD_SITE @ tf.make_transform(belief)) @ T_world_optical
+    empty = view_nest(depth, CameraIntrinsics(), T_site_optical, sizes)
+    assert empty.occupied is False and abs(empty.height_m - 0.005) < 0.002, empty.reason
+
+    def seen(plate_bottom_m: float):  # noqa: ANN202
+        depth, T_world_optical = _render(PLATE, plate_pose=(0.0, 0.0, plate_bottom_m, 0.0))
+        T_site_optical = tf.invert(T_WORLD_SITE @ tf.make_transform(belief)) @ T_world_optical
+        return view_nest(depth, CameraIntrinsics(), T_site_optical, sizes, floor_m=empty.height_m)
+
+    assert seen(0.0).seated, seen(0.0).reason
+    on_rims = seen(RIM)
+    assert on_rims.occupied is True and not on_rims.seated, on_rims.reason
