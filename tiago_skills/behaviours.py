@@ -47,9 +47,8 @@ OPEN_FINGER_REACH = rm.FINGER_MOUNT_OFFSET + rm.FINGER_TRAVEL + rm.PAD_THICKNESS
 BENCH_EDGE_MARGIN = 0.02
 BENCH_FRONT_X = WORKING_CLEARANCE - OPEN_FINGER_REACH - BENCH_EDGE_MARGIN
 
-# Fingers closed on a plate stand its short side apart; a plate grasped tilted by more than about 28
-# deg about its long side (the pads on its edges, seen once: fingers 75 mm apart on an 85.5 mm plate,
-# which then fell over in the hotel) stands more than this closer or wider.
+# Fingers closed on a plate stand its short side apart; on a plate tilted over 28 deg about its long
+# side (seen: 75 mm apart on an 85.5 mm plate, which then fell over in the hotel) off by more than this.
 GRASP_WIDTH_TOLERANCE_M = 0.004
 
 # Half-turn about the grasp x axis: the same top-down grasp with the fingers swapped.
