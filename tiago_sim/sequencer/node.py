@@ -127,7 +127,8 @@ class Sequencer:
         try:
             workcell = await self._describe()
         except StepFailed as failure:
-            log.warning("%s; asking again with the first goal", failure.message)
+            log.warning("%s; asking again with the next robot state", failure.message)
+            self.described_at_start = False
             return
         log.info("lab-added sensors read: %s", ", ".join(workcell.sensors.names()) or "none")
         self._follow_sensors()
