@@ -178,7 +178,11 @@ def test_plate_taken_away_during_get_labware_is_labware_not_picked_and_the_next_
         time.sleep(0.02)
     set_fault(cell, "fault.remove_plate", PLATE)
     try:
-        expect_error("LabwareNotPicked", get, "GRASP_FAILED")
+        # The robot runs ahead of this test's polling: taken away before the grasp, the fingers
+        # close on nothing (GRASP_FAILED); taken out of the hand after it, the fingers say so at the
+        # next check (PLATE_SLIPPED, seen in an idle CI run). Either is a pick the robot refuses.
+        error = expect_error("LabwareNotPicked", get, "")
+        assert "GRASP_FAILED" in error.message or "PLATE_SLIPPED" in error.message, error.message
         assert_lost(cell, PLATE)
         assert not cell.nest_occupied()[B1]
         assert cell.robot_state() != "Error"
