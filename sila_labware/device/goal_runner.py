@@ -56,8 +56,8 @@ class GoalRunner:
 
     def stop(self) -> bool:
         """Cancel whatever goal runs and return once the robot stands (bounded: `waits.cancel_s`
-        for the goal, `waits.state_report_s` for the state), so that every state property already
-        says so; True if a goal was running."""
+        for the goal, and again for the state), so that every state property already says so; True
+        if a goal was running."""
         with self._active_lock:
             goal = self._active_goal
         if goal is None or goal.done:
@@ -92,20 +92,28 @@ class GoalRunner:
             goal.wait(self.waits.cancel_s)
         except BridgeError:
             logger.warning("%s: no end within %.0f s of the cancel", goal.action_name, self.waits.cancel_s)
-        self.await_state(lambda status: status.at_rest, "the robot at rest")
+        # Bounded by cancel_s, not state_report_s: a braking base reports its stand only once it
+        # stands, which on a busy machine at a real-time pace took longer than 2 s of wall time (a
+        # cancel answered while RobotState still read Navigating, in a CI run).
+        self.await_state(lambda status: status.at_rest, "the robot at rest", within_s=self.waits.cancel_s)
 
     def await_state(
-        self, shows: Callable[[RobotStatus], bool], what: str, progress: CommandProgress | None = None
+        self,
+        shows: Callable[[RobotStatus], bool],
+        what: str,
+        progress: CommandProgress | None = None,
+        within_s: float | None = None,
     ) -> None:
         """After a base motion succeeded, wait until /robot_state shows its effect, so that the
         command ends with the state properties (and the next command's checks) already true: the
         state topic lags action results. The command's `progress` then says what remains: at most
         this wait (a client counts a remaining time down, and the goal's last estimate has run
-        out)."""
+        out). Bounded by `within_s` (default `waits.state_report_s`)."""
+        bound_s = self.waits.state_report_s if within_s is None else within_s
         if progress is not None:
             progress.report(progress.fraction, self.waits.state_report_s)
         try:
-            self._link.wait_for_robot_status(shows, self.waits.state_report_s)
+            self._link.wait_for_robot_status(shows, bound_s)
         except BridgeTimeout:
             logger.warning("the motion succeeded but the robot state does not report %s yet", what)
 
