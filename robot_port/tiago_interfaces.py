@@ -40,6 +40,7 @@ DOCK_ROBOT = "/dock_robot"
 UNDOCK_ROBOT = "/undock_robot"
 BATTERY_STATE = "/battery_state"
 TF = "/tf"
+TF_STATIC = "/tf_static"
 
 TIAGO_INTERFACES: tuple[RosInterface, ...] = (
     *(
@@ -61,6 +62,9 @@ TIAGO_INTERFACES: tuple[RosInterface, ...] = (
     RosInterface(CAMERA_DEPTH, "sensor_msgs/msg/Image", "topic", "depth registered to the colour image"),
     RosInterface(JOINT_STATES, "sensor_msgs/msg/JointState", "topic", "every joint's reading"),
     RosInterface(TF, "tf2_msgs/msg/TFMessage", "topic", "localisation's map -> odom correction"),
+    RosInterface(
+        TF_STATIC, "tf2_msgs/msg/TFMessage", "topic", "the robot's fixed frames (the laser's mount)"
+    ),
     RosInterface("/clock", "rosgraph_msgs/msg/Clock", "topic", "the simulator's time (a simulation only)"),
     RosInterface(NAVIGATE_TO_POSE, "nav2_msgs/action/NavigateToPose", "action", "Nav2's navigation goal"),
     # lab-added: Nav2's docking server and the battery state its charging dock reads
@@ -68,5 +72,5 @@ TIAGO_INTERFACES: tuple[RosInterface, ...] = (
     RosInterface(UNDOCK_ROBOT, "nav2_msgs/action/UndockRobot", "action", "off the charging dock"),
     RosInterface(BATTERY_STATE, "sensor_msgs/msg/BatteryState", "topic", "charging while on the dock"),
 )
-"""What the simulator serves today. Not yet: /tf_static (the mounts are the robot model's), and
-/play_motion2 (the skills send their own keyframes to the controllers)."""
+"""What the simulator serves today. Not yet: /play_motion2 (the skills send their own keyframes to
+the controllers)."""

@@ -50,6 +50,8 @@ TORSO_LIFT_SPEED = 0.07
 # Gripper
 LASER_MOUNT = (0.202, 0.0, 0.0)
 """The base laser's frame (base_laser_link) in base_footprint: x, y (m) and yaw (rad)."""
+LASER_HEIGHT = WHEEL_RADIUS - 0.004
+"""The base laser's frame above the floor (m)."""
 FINGER_TRAVEL = 0.045
 FINGER_MOUNT_OFFSET = 0.005  # inner pad face at this distance from centre when a finger joint is 0
 # Fingers closed on nothing stop with their pads 2 * FINGER_MOUNT_OFFSET apart; closed further apart
@@ -363,7 +365,23 @@ def build_urdf() -> str:
     for side in ARM_SIDES:
         _add_arm(writer, side)
     add_hotel(writer, WHEEL_RADIUS)
+    _add_laser_frame(writer)  # last: the links before it keep their PyBullet indices
     return writer.text()
+
+
+def _add_laser_frame(w: UrdfWriter) -> None:
+    """The base laser's frame (no body: the laser is cast, see tiago_sim.physics.base_laser), so that
+    the robot's fixed frames on /tf_static name it as a TIAGo++'s robot_state_publisher does."""
+    x, y, yaw = LASER_MOUNT
+    w.link("base_laser_link")
+    w.joint(
+        "base_laser_joint",
+        "fixed",
+        "base_link",
+        "base_laser_link",
+        (x, y, LASER_HEIGHT - WHEEL_RADIUS),
+        (0, 0, yaw),
+    )
 
 
 def urdf_path() -> Path:

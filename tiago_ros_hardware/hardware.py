@@ -13,7 +13,8 @@ lab's dock; "" for its only one), and whether the robot is docked is the battery
 Nav2's charging dock reads it from `/battery_state`.
 
 The names and types are robot_port.tiago_interfaces'. Localisation's correction is the map -> odom
-transform on the robot's `/tf`, as AMCL sends it.
+transform on the robot's `/tf`, as AMCL sends it; the laser's mount is the robot's own, from the
+fixed frames robot_state_publisher latches on `/tf_static`.
 
 Threads: the node's callbacks on its executor's threads (the caller spins the node, with threads to
 spare for the goals' answers); every port method on any thread.
@@ -35,7 +36,7 @@ from nav_msgs.msg import Odometry
 from rclpy.action import ActionClient
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
-from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import BatteryState, CameraInfo, Image, JointState
 from sensor_msgs.msg import LaserScan as LaserScanMsg
@@ -56,12 +57,14 @@ from robot_port.tiago_interfaces import (
     NAVIGATE_TO_POSE,
     ODOMETRY,
     TF,
+    TF_STATIC,
     UNDOCK_ROBOT,
     controller_action,
 )
 from robot_port.types import JOINT_GROUPS, CameraFrame, CameraIntrinsics, JointTrajectory, LaserScan, Pose2D
 from tiago_description import robot_model as rm
 from tiago_description import transforms as tf
+from tiago_description.fixed_frames import FixedFrame, chain
 from tiago_description.joint_limits import velocity_limits
 from tiago_ros_hardware.base_loops import drive_loop, velocity_loop
 from tiago_ros_hardware.executions import FailedExecution, GoalsExecution, LoopExecution
@@ -70,7 +73,7 @@ from tiago_ros_hardware.trajectory_goals import controller_goals, duration_msg
 
 READING_TIMEOUT_S = 30.0
 """Wall seconds a reading may wait for its topic before the robot counts as gone."""
-MAP_FRAME, ODOM_FRAME = "map", "odom"
+MAP_FRAME, ODOM_FRAME, BASE_FRAME = "map", "odom", "base_footprint"
 NAVIGATION_SPEED_MPS = 0.5  # for the time-left estimate of a navigation goal only
 DOCKING_S = 8.0  # for the time-left estimate of docking and undocking only
 
@@ -95,6 +98,8 @@ class RosHardware:
         self._clock_s: float | None = None
         self._clock_changed = threading.Condition()
         self._correction: Pose2D = (0.0, 0.0, 0.0)
+        self._fixed: dict[str, FixedFrame] = {}  # the robot's fixed frames by child, from /tf_static
+        self._fixed_changed = threading.Condition()
         self.joints = TopicHistory(JOINT_STATES)
         self.odom = TopicHistory(ODOMETRY)
         self.scans = TopicHistory(LASER)
@@ -107,6 +112,10 @@ class RosHardware:
         self._subscribe(JointState, JOINT_STATES, self._on_joints, reliable)
         self._subscribe(Odometry, ODOMETRY, self._on_odometry, reliable)
         self._subscribe(TFMessage, TF, self._on_tf, reliable)
+        latched = QoSProfile(
+            depth=10, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
+        )
+        self._subscribe(TFMessage, TF_STATIC, self._on_tf_static, latched)
         self._subscribe(BatteryState, BATTERY_STATE, self.battery.add, reliable)
         self._settled = {"joints": 0, "odom": 0, "battery": 0}  # counts after which readings show it at rest
         self.cmd_vel = node.create_publisher(Twist, CMD_VEL, reliable)
@@ -145,6 +154,32 @@ class RosHardware:
             if (stamped.header.frame_id, stamped.child_frame_id) == (MAP_FRAME, ODOM_FRAME):
                 t = stamped.transform
                 self._correction = (float(t.translation.x), float(t.translation.y), yaw_of(t.rotation))
+
+    def _on_tf_static(self, message: TFMessage) -> None:
+        """The robot's fixed frames (robot_state_publisher sends them once, latched)."""
+        with self._fixed_changed:
+            for stamped in message.transforms:
+                t = stamped.transform
+                transform = tf.from_pose(
+                    (t.translation.x, t.translation.y, t.translation.z),
+                    (t.rotation.x, t.rotation.y, t.rotation.z, t.rotation.w),
+                )
+                self._fixed[stamped.child_frame_id] = FixedFrame(
+                    stamped.header.frame_id, stamped.child_frame_id, transform
+                )
+            self._fixed_changed.notify_all()
+
+    def _mount(self, frame: str) -> Pose2D:
+        """Where `frame` sits on the base (x, y, yaw in base_footprint), from /tf_static."""
+        with self._fixed_changed:
+            found = self._fixed_changed.wait_for(
+                lambda: chain(self._fixed, BASE_FRAME, frame) is not None, READING_TIMEOUT_S
+            )
+            if not found:
+                raise HardwareUnavailable(f"no fixed frames from {BASE_FRAME} to {frame} on {TF_STATIC}")
+            transform = chain(self._fixed, BASE_FRAME, frame)
+        assert transform is not None
+        return float(transform[0, 3]), float(transform[1, 3]), tf.yaw_of(transform)
 
     # -- clock and readings --------------------------------------------------------------------
     def now(self) -> float:
@@ -196,7 +231,7 @@ class RosHardware:
             angle_increment=float(message.angle_increment),
             range_min=float(message.range_min),
             range_max=float(message.range_max),
-            mount=rm.LASER_MOUNT,
+            mount=self._mount(message.header.frame_id),
             odometry=odometry[0] if odometry is not None else self.odometry(),
             stamp_s=stamp,
         )

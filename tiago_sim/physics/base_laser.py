@@ -50,7 +50,7 @@ class LaserSpec:
 
     mount_x: float = rm.LASER_MOUNT[0]  # m ahead of base_footprint
     mount_y: float = rm.LASER_MOUNT[1]
-    mount_z: float = rm.WHEEL_RADIUS - 0.004  # 0.0945 m above the floor
+    mount_z: float = rm.LASER_HEIGHT  # 0.0945 m above the floor
     mount_yaw: float = rm.LASER_MOUNT[2]
     angle_min: float = -math.radians(110.0)
     angle_max: float = math.radians(110.0)

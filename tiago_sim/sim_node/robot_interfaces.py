@@ -4,8 +4,9 @@ Why: the skills reach the twin through the hardware port in-process, the fast wa
 software written against a real robot (and the port's ROS adapter) speaks the robot's interfaces
 instead (robot_port.tiago_interfaces). These are the ones the sensor topics do not already give:
 the controllers' actions (controllers), the base's velocity input, Nav2's navigation goal and the
-docking a lab adds (base_interfaces), localisation's map -> odom on /tf (tf_topic). Off by
-default: their endpoints cost discovery and CPU in every trial.
+docking a lab adds (base_interfaces), localisation's map -> odom on /tf and the robot model's
+fixed frames on /tf_static (tf_topic). Off by default: their endpoints cost discovery and CPU in
+every trial.
 """
 
 from __future__ import annotations
@@ -15,12 +16,14 @@ import logging
 from rclpy.node import Node
 
 from lab_description.world import World
+from tiago_description.fixed_frames import fixed_frames
+from tiago_description.robot_model import build_urdf
 from tiago_sim.sim_node.base_interfaces import BaseVelocityInput, DockingServers, NavigateToPoseServer
 from tiago_sim.sim_node.controllers import TrajectoryControllers
 from tiago_sim.sim_node.localisation_topics import LocalisationTopics
 from tiago_sim.sim_node.navigation import Navigation
 from tiago_sim.sim_node.sim_thread import SimThread
-from tiago_sim.sim_node.tf_topic import MapToOdomBroadcast
+from tiago_sim.sim_node.tf_topic import MapToOdomBroadcast, static_transforms
 
 log = logging.getLogger(__name__)
 
@@ -39,6 +42,7 @@ class RobotInterfaces:
         self.controllers = TrajectoryControllers(node, sim_thread)
         self.tf = MapToOdomBroadcast(node)
         localisation_topics.correction_listeners.append(self.tf.update)
+        static_transforms(node, fixed_frames(build_urdf()))
         self.velocity = BaseVelocityInput(node, sim_thread)
         self.navigation = NavigateToPoseServer(node, navigation, sim_thread)
         self.docking = DockingServers(node, world, navigation, sim_thread)
