@@ -19,7 +19,7 @@ class RosInterface:
 
     name: str
     type: str
-    kind: str  # "topic" or "action"
+    kind: str  # "topic", "action" or "service"
     what: str
 
 
@@ -41,6 +41,9 @@ UNDOCK_ROBOT = "/undock_robot"
 BATTERY_STATE = "/battery_state"
 TF = "/tf"
 TF_STATIC = "/tf_static"
+PLAY_MOTION2 = "/play_motion2"
+LIST_MOTIONS = "/play_motion2/list_motions"
+IS_MOTION_READY = "/play_motion2/is_motion_ready"
 
 TIAGO_INTERFACES: tuple[RosInterface, ...] = (
     *(
@@ -67,10 +70,18 @@ TIAGO_INTERFACES: tuple[RosInterface, ...] = (
     ),
     RosInterface("/clock", "rosgraph_msgs/msg/Clock", "topic", "the simulator's time (a simulation only)"),
     RosInterface(NAVIGATE_TO_POSE, "nav2_msgs/action/NavigateToPose", "action", "Nav2's navigation goal"),
+    RosInterface(
+        PLAY_MOTION2, "play_motion2_msgs/action/PlayMotion2", "action", "named motions (play_motion2)"
+    ),
+    RosInterface(LIST_MOTIONS, "play_motion2_msgs/srv/ListMotions", "service", "the named motions' keys"),
+    RosInterface(
+        IS_MOTION_READY, "play_motion2_msgs/srv/IsMotionReady", "service", "whether a named motion can play"
+    ),
     # lab-added: Nav2's docking server and the battery state its charging dock reads
     RosInterface(DOCK_ROBOT, "nav2_msgs/action/DockRobot", "action", "onto the charging dock"),
     RosInterface(UNDOCK_ROBOT, "nav2_msgs/action/UndockRobot", "action", "off the charging dock"),
     RosInterface(BATTERY_STATE, "sensor_msgs/msg/BatteryState", "topic", "charging while on the dock"),
 )
-"""What the simulator serves today. Not yet: /play_motion2 (the skills send their own keyframes to
-the controllers)."""
+"""What the simulator serves (with --robot-interfaces). The skills use all but /play_motion2 and its
+services: they time their own keyframes and chain them with straight tool moves (see
+docs/reference/robot-interfaces.md); the adapter plays named motions for a lab's tools."""

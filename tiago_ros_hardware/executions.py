@@ -135,6 +135,7 @@ class GoalsExecution(_Outcome):
                 why = (
                     getattr(result, "error_string", "")
                     or getattr(result, "error_msg", "")
+                    or getattr(result, "error", "")
                     or f"status {status}"
                 )
                 self._failures.append((self._failure_code, f"{action}: {why}"))

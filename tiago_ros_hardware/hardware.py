@@ -33,6 +33,7 @@ from control_msgs.action import FollowJointTrajectory
 from geometry_msgs.msg import PoseStamped, Twist
 from nav2_msgs.action import DockRobot, NavigateToPose, UndockRobot
 from nav_msgs.msg import Odometry
+from play_motion2_msgs.action import PlayMotion2
 from rclpy.action import ActionClient
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
@@ -56,6 +57,7 @@ from robot_port.tiago_interfaces import (
     LASER,
     NAVIGATE_TO_POSE,
     ODOMETRY,
+    PLAY_MOTION2,
     TF,
     TF_STATIC,
     UNDOCK_ROBOT,
@@ -128,7 +130,27 @@ class RosHardware:
         self.navigation = ActionClient(node, NavigateToPose, NAVIGATE_TO_POSE, callback_group=self._group)
         self.docking = ActionClient(node, DockRobot, DOCK_ROBOT, callback_group=self._group)
         self.undocking = ActionClient(node, UndockRobot, UNDOCK_ROBOT, callback_group=self._group)
+        self.named_motions = ActionClient(node, PlayMotion2, PLAY_MOTION2, callback_group=self._group)
         self.limits = velocity_limits()
+
+    def wait_until_ready(self, timeout_s: float = READING_TIMEOUT_S) -> None:
+        """Return once every action server the adapter sends goals to answers and the joints,
+        odometry (and, on a simulator, the clock) have been heard; else HardwareUnavailable naming
+        what is missing. Why: a goal sent before its server is discovered can be lost unanswered."""
+        clients = {
+            **{controller_action(group): client for group, client in self.controllers.items()},
+            NAVIGATE_TO_POSE: self.navigation,
+            DOCK_ROBOT: self.docking,
+            UNDOCK_ROBOT: self.undocking,
+            PLAY_MOTION2: self.named_motions,
+        }
+        for name, client in clients.items():
+            if not client.wait_for_server(timeout_sec=timeout_s):
+                raise HardwareUnavailable(f"no action server {name} within {timeout_s:.0f} s")
+        for history in (self.joints, self.odom):
+            history.after(0, timeout_s)  # HardwareUnavailable names the topic
+        if self.simulated_clock:
+            self.now()
 
     def _subscribe(self, kind: Any, topic: str, callback: Any, qos: QoSProfile) -> None:
         self.node.create_subscription(kind, topic, callback, qos, callback_group=self._group)
@@ -404,6 +426,27 @@ class RosHardware:
             {"base"},
             lambda: GoalsExecution(
                 name, sent, self._now_or_zero, DOCKING_S, "MOTION_FAILED", on_end=self._command_ended
+            ),
+        )
+
+    def play_motion(self, key: str, skip_planning: bool = False, expected_s: float = 5.0) -> Execution:
+        """A named motion of the robot's play_motion2 (`key` as its motions file names it), with
+        the arms, the torso and the head claimed while it plays. Not a port method: the skills time
+        their own keyframes and chain them with tool moves (docs/reference/robot-interfaces.md);
+        this is for a lab's start-up and tools. `skip_planning` as play_motion2's goal: False lets
+        a robot with MoveIt plan the approach to the first row (PAL's advice); `expected_s` is
+        for the time-left estimate only."""
+        goal = PlayMotion2.Goal(motion_name=key, skip_planning=skip_planning)
+        sent = [(PLAY_MOTION2, self.named_motions, goal)]
+        return self._claim(
+            {"arm_left", "arm_right", "torso", "head"},
+            lambda: GoalsExecution(
+                f"motion {key}",
+                sent,
+                self._now_or_zero,
+                expected_s,
+                "MOTION_FAILED",
+                on_end=self._command_ended,
             ),
         )
 

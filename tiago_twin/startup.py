@@ -24,7 +24,7 @@ from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
 
 from lab_description.world import DEFAULT_WORLD, World, WorldError, load_world, with_stock_sensors
-from tiago_description.motion_library import DEFAULT_MOTIONS_FILE
+from tiago_description.motion_library import DEFAULT_MOTIONS_FILE, load_motions
 from tiago_sim.measuring.run_recorder import RunRecorder
 from tiago_sim.node_main import spin_node
 from tiago_sim.sim_node.hardware import SimulatedHardware
@@ -175,7 +175,12 @@ def main(argv: list[str] | None = None) -> int:
             from tiago_sim.sim_node.robot_interfaces import RobotInterfaces
 
             sim_node.robot_interfaces = RobotInterfaces(
-                node, believed, sim_thread, navigation, sim_node.publishers.localisation_topics
+                node,
+                believed,
+                sim_thread,
+                navigation,
+                sim_node.publishers.localisation_topics,
+                load_motions(args.motions),
             )
         lab_reset = LabReset(node, sim_thread, skills.actions.slot)
         lab_reset.hooks += [sim_node.forget_the_old_lab, skills.forget]

@@ -19,17 +19,21 @@ import pytest
 import rclpy
 from geometry_msgs.msg import Pose2D as Pose2DMsg
 from geometry_msgs.msg import TransformStamped
+from rclpy.action import get_action_client_names_and_types_by_node
 from rclpy.executors import MultiThreadedExecutor
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
 from lab_description.world import DEFAULT_WORLD, load_world
 from robot_port.hardware import RobotHardware
+from robot_port.tiago_interfaces import PLAY_MOTION2, TIAGO_INTERFACES
 from robot_port.trajectory_timing import profiled_path
 from robot_port.types import JointTrajectory
 from tests.helpers.ros_processes import RosCaller, running
 from tiago_description import robot_model as rm
 from tiago_description import transforms as tf
 from tiago_description.joint_limits import velocity_limits
+from tiago_description.motion_library import load_motions
+from tiago_description.named_motions import named_motions
 from tiago_ros_hardware.hardware import RosHardware
 
 WAIT_S = 120.0
@@ -56,7 +60,7 @@ def robot(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[RosHardwar
         spinner.start()
         try:
             hardware = RosHardware(node)
-            hardware.joint_positions()  # the twin is up and publishing
+            hardware.wait_until_ready()  # every action server found, the twin publishing
             yield hardware, caller
         finally:
             executor.shutdown()
@@ -200,3 +204,43 @@ def test_the_pose_estimate_takes_localisations_correction_from_tf(
     assert any(abs(v) > 1e-9 for v in correction), "an identity correction would prove nothing"
     expected = tf.compose_planar(hardware._correction, hardware.odometry())
     assert np.allclose(hardware.pose_estimate(), expected, atol=1e-3)
+
+
+def test_the_adapter_speaks_only_listed_interfaces_with_their_types(
+    robot: tuple[RosHardware, RosCaller],
+) -> None:
+    """Everything the adapter subscribes to, publishes and sends goals to is in the list of a
+    TIAGo++'s interfaces (robot_port.tiago_interfaces), with the listed type; the docs' table
+    cites each entry's source."""
+    hardware, _caller = robot
+    node, name, namespace = hardware.node, hardware.node.get_name(), hardware.node.get_namespace()
+    listed = {(interface.name, interface.type) for interface in TIAGO_INTERFACES}
+    used = {
+        (topic, kind)
+        for reader in (
+            node.get_subscriber_names_and_types_by_node,
+            node.get_publisher_names_and_types_by_node,
+        )
+        for topic, kinds in reader(name, namespace)
+        for kind in kinds
+        if "/_action/" not in topic and topic != "/parameter_events" and topic != "/rosout"
+    }
+    used |= {
+        (action, kind)
+        for action, kinds in get_action_client_names_and_types_by_node(node, name, namespace)
+        for kind in kinds
+    }
+    assert (PLAY_MOTION2, "play_motion2_msgs/action/PlayMotion2") in used
+    assert used <= listed, sorted(used - listed)
+
+
+def test_a_named_motion_plays_through_play_motion2(robot: tuple[RosHardware, RosCaller]) -> None:
+    hardware, _caller = robot
+    execution = finished(hardware.play_motion("tuck_right"))
+    assert execution.success, execution.message
+    last = named_motions(load_motions())["tuck_right"].frames[-1]
+    now = hardware.joint_positions()
+    assert [now[joint] for joint in last] == pytest.approx(list(last.values()), abs=0.02)
+    unknown = finished(hardware.play_motion("wave"))
+    assert not unknown.success and unknown.error_code == "MOTION_FAILED"
+    assert "unknown motion 'wave'" in unknown.message

@@ -24,7 +24,6 @@ from typing import Any
 from builtin_interfaces.msg import Duration
 from geometry_msgs.msg import Twist
 from nav2_msgs.action import DockRobot, NavigateToPose, UndockRobot
-from rclpy.action import ActionServer, CancelResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
@@ -32,6 +31,7 @@ from sensor_msgs.msg import BatteryState
 
 from lab_description.world import World
 from robot_port.tiago_interfaces import BATTERY_STATE, CMD_VEL, DOCK_ROBOT, NAVIGATE_TO_POSE, UNDOCK_ROBOT
+from tiago_sim.sim_node.action_server import cancellable_server
 from tiago_sim.sim_node.hardware import MotionExecution
 from tiago_sim.sim_node.localisation_topics import stamp_of
 from tiago_sim.sim_node.navigation import Navigation
@@ -87,14 +87,7 @@ class NavigateToPoseServer:
     def __init__(self, node: Node, navigation: Navigation, sim_thread: SimThread) -> None:
         self.navigation = navigation
         self.sim_thread = sim_thread
-        self.server = ActionServer(
-            node,
-            NavigateToPose,
-            NAVIGATE_TO_POSE,
-            execute_callback=self._execute,
-            cancel_callback=lambda _handle: CancelResponse.ACCEPT,
-            callback_group=ReentrantCallbackGroup(),
-        )
+        self.server = cancellable_server(node, NavigateToPose, NAVIGATE_TO_POSE, self._execute)
 
     def _execute(self, handle: Any) -> NavigateToPose.Result:
         pose = handle.request.pose.pose
@@ -139,14 +132,9 @@ class DockingServers:
         self.navigation = navigation
         self.sim_thread = sim_thread
         group = ReentrantCallbackGroup()
-        cancel = lambda _handle: CancelResponse.ACCEPT  # noqa: E731
         self.servers = [
-            ActionServer(
-                node, DockRobot, DOCK_ROBOT, self._dock, cancel_callback=cancel, callback_group=group
-            ),
-            ActionServer(
-                node, UndockRobot, UNDOCK_ROBOT, self._undock, cancel_callback=cancel, callback_group=group
-            ),
+            cancellable_server(node, DockRobot, DOCK_ROBOT, self._dock, group),
+            cancellable_server(node, UndockRobot, UNDOCK_ROBOT, self._undock, group),
         ]
         reliable = QoSProfile(depth=2, reliability=ReliabilityPolicy.RELIABLE)
         self.battery = node.create_publisher(BatteryState, BATTERY_STATE, reliable)

@@ -26,7 +26,7 @@ import time
 from typing import Any
 
 from control_msgs.action import FollowJointTrajectory
-from rclpy.action import ActionServer, CancelResponse, GoalResponse
+from rclpy.action import GoalResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 from trajectory_msgs.msg import JointTrajectoryPoint
@@ -34,6 +34,7 @@ from trajectory_msgs.msg import JointTrajectoryPoint
 from robot_port.tiago_interfaces import controller_action
 from robot_port.types import JOINT_GROUPS
 from tiago_description import robot_model as rm
+from tiago_sim.sim_node.action_server import cancellable_server
 from tiago_sim.sim_node.localisation_topics import stamp_of
 from tiago_sim.sim_node.sim_thread import SimThread
 
@@ -85,14 +86,13 @@ class TrajectoryControllers:
         self.goals = dict.fromkeys(JOINT_GROUPS, 0)  # goals run, per controller
         group = ReentrantCallbackGroup()
         self.servers = [
-            ActionServer(
+            cancellable_server(
                 node,
                 FollowJointTrajectory,
                 controller_action(name),
-                execute_callback=lambda handle, name=name: self._execute(name, handle),
-                goal_callback=lambda goal, name=name: self._check(name, goal),
-                cancel_callback=lambda _handle: CancelResponse.ACCEPT,
-                callback_group=group,
+                lambda handle, name=name: self._execute(name, handle),
+                group,
+                check=lambda goal, name=name: self._check(name, goal),
             )
             for name in JOINT_GROUPS
         ]

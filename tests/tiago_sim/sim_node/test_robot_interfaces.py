@@ -21,6 +21,8 @@ from geometry_msgs.msg import Pose2D, PoseStamped, Twist
 from labware_interfaces.action import Undock
 from nav2_msgs.action import NavigateToPose
 from nav_msgs.msg import Odometry
+from play_motion2_msgs.action import PlayMotion2
+from play_motion2_msgs.srv import IsMotionReady, ListMotions
 from rclpy.action import get_action_names_and_types
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectoryPoint
@@ -28,12 +30,18 @@ from trajectory_msgs.msg import JointTrajectoryPoint
 from lab_description.world import DEFAULT_WORLD, load_world
 from robot_port.tiago_interfaces import (
     CMD_VEL,
+    IS_MOTION_READY,
+    LIST_MOTIONS,
     NAVIGATE_TO_POSE,
     ODOMETRY,
+    PLAY_MOTION2,
+    TIAGO_INTERFACES,
     controller_action,
 )
 from robot_port.types import JOINT_GROUPS
 from tests.helpers.ros_processes import RosCaller, running
+from tiago_description.motion_library import load_motions
+from tiago_description.named_motions import named_motions
 from tiago_description.robot_model import controller_joints
 
 HEAD = controller_action("head")
@@ -226,3 +234,47 @@ def test_a_navigation_goal_brings_the_base_to_the_pose(robot: RosCaller) -> None
     truth = robot.latest["/ground_truth/base_pose"]
     assert math.hypot(truth.x - target.x, truth.y - target.y) < 0.25  # Nav2's default goal checker
     assert abs(math.remainder(truth.theta - target.yaw, math.tau)) < 0.25
+
+
+def test_every_interface_of_the_list_is_served_under_its_name_and_type(robot: RosCaller) -> None:
+    """robot_port.tiago_interfaces lists what software of a real TIAGo++ (and the ROS adapter) finds
+    on the robot: the simulator serves every entry, with the listed type."""
+    kinds = {
+        "topic": robot.node.get_topic_names_and_types,
+        "action": lambda: get_action_names_and_types(robot.node),
+        "service": robot.node.get_service_names_and_types,
+    }
+    missing: list[str] = []
+
+    def served() -> bool:
+        found = {kind: dict(names()) for kind, names in kinds.items()}
+        missing[:] = [
+            f"{interface.kind} {interface.name} ({interface.type})"
+            for interface in TIAGO_INTERFACES
+            if interface.type not in found[interface.kind].get(interface.name, [])
+        ]
+        return not missing
+
+    try:
+        robot.wait_for(served, 30.0, "every listed interface")
+    except AssertionError as error:
+        raise AssertionError(f"not served: {missing}") from error
+
+
+def test_named_motions_are_listed_and_played_through_the_controllers(robot: RosCaller) -> None:
+    keys = robot.call_service(ListMotions, LIST_MOTIONS, ListMotions.Request()).motion_keys
+    assert {"travel_right", "tuck_left", "benchtop_right"} <= set(keys)
+    ready = robot.call_service(IsMotionReady, IS_MOTION_READY, IsMotionReady.Request(motion_key="tuck_right"))
+    assert ready.is_ready
+    unknown = robot.call_service(IsMotionReady, IS_MOTION_READY, IsMotionReady.Request(motion_key="wave"))
+    assert not unknown.is_ready
+
+    outcome = robot.call_action(PlayMotion2, PLAY_MOTION2, PlayMotion2.Goal(motion_name="tuck_right"), 120.0)
+    assert outcome.status == GoalStatus.STATUS_SUCCEEDED and outcome.result.success, outcome.result.error
+    last = named_motions(load_motions())["tuck_right"].frames[-1]
+    now = joints_now(robot)
+    assert [now[name] for name in last] == pytest.approx(list(last.values()), abs=0.02)
+
+    refused = robot.call_action(PlayMotion2, PLAY_MOTION2, PlayMotion2.Goal(motion_name="wave"), 60.0)
+    assert refused.status == GoalStatus.STATUS_ABORTED and not refused.result.success
+    assert "unknown motion 'wave'" in refused.result.error and "tuck_right" in refused.result.error
