@@ -79,6 +79,7 @@ class TrialOutcome:
     plate_position_error_mm: float | None
     steps: list[dict[str, Any]] = field(default_factory=list)
     world: str = ""  # the world file the trial ran in (a generated layout's, with --random-layouts)
+    lost_runs: list[str] = field(default_factory=list)  # earlier runs whose worker died, and why
 
 
 PORTS_PER_WORKER = 10  # SiLA ports a worker may use from its base: the robot's and up to 9 stations'
@@ -291,6 +292,8 @@ def summarize(outcomes: list[TrialOutcome], levels: dict[str, float], seed: int)
             for o in outcomes
             if not o.success
         ],
+        # infrastructure, not the robot: trials run again because their worker process died
+        "rerun_trials": [{"seed": o.seed, "lost_runs": o.lost_runs} for o in outcomes if o.lost_runs],
         "levels": levels,
         "outcomes": [asdict(o) for o in outcomes],
     }
@@ -323,6 +326,13 @@ def format_table(summary: dict[str, Any]) -> str:
         f"placement error of delivered plates: median {summary['placement_error_mm_median']:.1f} mm, "
         f"max {summary['placement_error_mm_max']:.1f} mm",
     ]
+    reruns = summary.get("rerun_trials", [])
+    if reruns:
+        seeds = ", ".join(str(rerun["seed"]) for rerun in reruns)
+        lines.append(
+            f"run again after their worker process died (infrastructure, not counted as failures): "
+            f"{len(reruns)} trial(s), seeds {seeds}"
+        )
     if "elapsed_wall_seconds" in summary and summary["trials"]:
         elapsed = summary["elapsed_wall_seconds"]
         lines.append(

@@ -8,9 +8,12 @@ worker index) and so its own robot
 side; a trial's seed alone decides its disturbances and layout, whichever worker runs it.
 Workers are spawned (not forked: the parent may hold threads and DDS state). Ctrl-C or SIGTERM:
 the running trials are abandoned, each worker stops its deployment, the trials done are returned.
-A worker that dies (a crash in a native library) breaks its pool: the trials running then are
-recorded as failed ("other", naming the lost worker), never re-run, and the trials not yet
-started go on in a fresh pool, so one crash costs the trials it hit, not the campaign.
+A worker that dies (a crash in a native library) breaks its pool: the trials running then (which of
+them crashed it cannot be told) run once more, each alone in a pool of one worker, before the
+trials not yet started go on in a fresh pool; their outcomes say so (`lost_runs`; the summary lists
+them apart, as infrastructure). A trial whose worker dies under it when it runs alone fails
+("other", "worker lost twice"): the trial itself crashes it, which is the software's fault, and its
+replay shows it. So one crash costs the campaign neither the trials it hit nor the rest.
 
 Threads: the caller's thread (the CLI's main thread) in the parent; each worker's main thread.
 """
@@ -27,7 +30,7 @@ import tempfile
 from collections.abc import Callable
 from concurrent.futures import Future, ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, TextIO
 
@@ -95,18 +98,23 @@ def _noted_trials(started_dir: Path, broken: BrokenProcessPool) -> _Lost:
     return _Lost(begun, ended, broken)
 
 
-def lost_trial(trial_seed: int, why: str) -> TrialOutcome:
-    """The outcome of a trial whose worker died under it: a failure of cause "other"."""
+def lost_trial(trial_seed: int, lost_runs: list[str]) -> TrialOutcome:
+    """The outcome of a trial whose worker died under it twice: a failure of cause "other"."""
     return TrialOutcome(
         seed=trial_seed,
         success=False,
         cause="other",
-        error=f"worker lost: {why}",
+        error=f"worker lost twice: {lost_runs[-1]}",
         sim_seconds=0.0,
         wall_seconds=0.0,
         startup_wall_seconds=0.0,
         plate_position_error_mm=None,
+        lost_runs=list(lost_runs),
     )
+
+
+LOST_RUNS_ALLOWED = 1
+"""Runs of one trial that may end in a dead worker before the trial counts as failed."""
 
 
 def run_parallel_campaign(
@@ -121,33 +129,58 @@ def run_parallel_campaign(
     outcomes: list[TrialOutcome] = []
     levels = {name: logging.getLogger(name or None).getEffectiveLevel() for name in ("", "sila_labware")}
     waiting = [options.seed + index for index in range(options.trials)]
+    lost_runs: dict[int, list[str]] = {}  # seed -> why each of its runs so far lost its worker
+    report = _Recorder(outcomes, progress, on_trial, replay_flags(options), lost_runs)
     while waiting:
-        waiting = _run_pool(options, waiting, levels, progress, outcomes, on_trial, trial)
+        # a trial that lost its worker runs again alone: a second death then is its own
+        again = [seed for seed in waiting if seed in lost_runs]
+        if again:
+            waiting = sorted(
+                set(waiting) - {again[0]} | set(_run_pool(options, again[:1], levels, report, trial, 1))
+            )
+        else:
+            waiting = _run_pool(options, waiting, levels, report, trial, options.jobs)
     return sorted(outcomes, key=lambda outcome: outcome.seed)
+
+
+@dataclass
+class _Recorder:
+    """Where finished trials go (see `record_outcome`), each with the runs of it a dead worker lost."""
+
+    outcomes: list[TrialOutcome]
+    progress: CampaignProgress
+    on_trial: Callable[[TrialOutcome], None] | None
+    flags: str
+    lost_runs: dict[int, list[str]]
+
+    def __call__(self, outcome: TrialOutcome) -> None:
+        lost = self.lost_runs.get(outcome.seed, [])
+        if lost and not outcome.lost_runs:
+            outcome = replace(outcome, lost_runs=list(lost))
+        record_outcome(outcome, self.outcomes, self.progress, self.on_trial, self.flags)
 
 
 def _run_pool(
     options: CampaignOptions,
     seeds: list[int],
     levels: dict[str, int],
-    progress: CampaignProgress,
-    outcomes: list[TrialOutcome],
-    on_trial: Callable[[TrialOutcome], None] | None,
+    report: _Recorder,
     trial: Callable[[CampaignOptions, int, bool], Any],
+    jobs: int,
 ) -> list[int]:
-    """Run `seeds` on a fresh pool; the seeds not started when a worker died (else none)."""
+    """Run `seeds` on a fresh pool of `jobs` workers; the seeds to run in the next one when a worker
+    died (else none)."""
     context = multiprocessing.get_context("spawn")
     indices = context.Queue()
-    for index in range(options.jobs):
+    for index in range(jobs):
         indices.put(index)
     started = tempfile.TemporaryDirectory(prefix="bench_started_")
     pool = ProcessPoolExecutor(
-        options.jobs, context, initializer=_start_worker, initargs=(indices, levels, started.name)
+        jobs, context, initializer=_start_worker, initargs=(indices, levels, started.name)
     )
     futures: dict[Future[TrialOutcome], int] = {
         pool.submit(_noted, trial, options, seed, seed == options.seed): seed for seed in seeds
     }
-    flags = replay_flags(options)
     try:
         for future in as_completed(futures):
             try:
@@ -155,11 +188,11 @@ def _run_pool(
             except BrokenProcessPool as broken:
                 pool.shutdown(wait=True, cancel_futures=True)  # the other workers stopped: notes final
                 lost = _noted_trials(Path(started.name), broken)
-                return _after_a_lost_worker(futures, lost, outcomes, progress, on_trial, flags)
-            record_outcome(outcome, outcomes, progress, on_trial, flags)
+                return _after_a_lost_worker(futures, lost, report)
+            report(outcome)
     except KeyboardInterrupt:
         logger.warning(
-            "interrupted: %d of %d trial(s) done; stopping the workers", len(outcomes), options.trials
+            "interrupted: %d of %d trial(s) done; stopping the workers", len(report.outcomes), options.trials
         )
         for future in futures:
             future.cancel()
@@ -172,26 +205,28 @@ def _run_pool(
 
 
 def _after_a_lost_worker(
-    futures: dict[Future[TrialOutcome], int],
-    lost: _Lost,
-    outcomes: list[TrialOutcome],
-    progress: CampaignProgress,
-    on_trial: Callable[[TrialOutcome], None] | None,
-    flags: str,
+    futures: dict[Future[TrialOutcome], int], lost: _Lost, report: _Recorder
 ) -> list[int]:
-    """A worker died: the trials that ended count, those that had begun and not ended fail (which of
-    them crashed its worker cannot be told), the rest wait for a fresh pool."""
-    done = {outcome.seed for outcome in outcomes}
+    """A worker died: the trials that ended count; those that had begun and not ended run again (which
+    of them crashed its worker cannot be told) unless a worker died under them before; the rest
+    wait for a fresh pool too."""
+    done = {outcome.seed for outcome in report.outcomes}
     waiting = []
     for future, seed in futures.items():
         if seed in done:
             continue
         if future.done() and not future.cancelled() and future.exception() is None:
-            record_outcome(future.result(), outcomes, progress, on_trial, flags)
+            report(future.result())
         elif seed in lost.ended:
-            record_outcome(lost.ended[seed], outcomes, progress, on_trial, flags)
+            report(lost.ended[seed])
         elif seed in lost.begun:
-            record_outcome(lost_trial(seed, str(lost.broken)), outcomes, progress, on_trial, flags)
+            runs = report.lost_runs.setdefault(seed, [])
+            runs.append(f"worker lost: {lost.broken}")
+            if len(runs) > LOST_RUNS_ALLOWED:
+                report(lost_trial(seed, runs))
+            else:
+                logger.warning("trial seed %d lost its worker: it runs again", seed)
+                waiting.append(seed)
         else:
             waiting.append(seed)
     logger.warning("a worker died (%s): %d trial(s) go on in a fresh pool", lost.broken, len(waiting))
