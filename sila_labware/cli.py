@@ -103,6 +103,7 @@ def build_parser() -> argparse.ArgumentParser:
     bench = subcommands.add_parser("bench", help="repeat the demo transfer under seeded disturbances")
     add_stack_arguments(bench, DEFAULT_WORLD)
     add_bench_arguments(bench)
+    pacing.add_pace_argument(bench)
     bluesky = subcommands.add_parser(
         "bluesky-demo",
         help="run the robot side and a Bluesky plan: pickup, place, measure, return the plate",

@@ -27,6 +27,8 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from sila_labware.benchmarks.levels import levels_json
+from sila_labware.client import remaining_time
+from sila_labware.client.remaining_time import RemainingCheck
 from sila_labware.deployment.demo import MISPLACED, DemoReport, run_demo
 from sila_labware.deployment.processes import interrupt_requested
 from sila_labware.deployment.stack import Deployment, DeploymentOptions
@@ -80,6 +82,7 @@ class TrialOutcome:
     steps: list[dict[str, Any]] = field(default_factory=list)
     world: str = ""  # the world file the trial ran in (a generated layout's, with --random-layouts)
     lost_runs: list[str] = field(default_factory=list)  # earlier runs whose worker died, and why
+    remaining: list[dict[str, Any]] = field(default_factory=list)  # RemainingCheck per step, as dicts
 
 
 PORTS_PER_WORKER = 10  # SiLA ports a worker may use from its base: the robot's and up to 9 stations'
@@ -158,6 +161,7 @@ def run_trial(
         plate_position_error_mm=report.plate_position_error_mm,
         steps=[asdict(step) for step in report.steps],
         world=str(stack.world),
+        remaining=[asdict(check) for check in report.remaining],
     )
 
 
@@ -222,7 +226,8 @@ def replay_flags(options: CampaignOptions) -> str:
     """What `bench --replay SEED` needs besides the seed to run a trial of this campaign again."""
     world = f" --world {options.stack.world}" if options.layouts_flag == "--random-obstacles" else ""
     layouts = f" {options.layouts_flag}{world}" if options.layouts_dir is not None else ""
-    return layouts + (" --real-robot" if options.real_robot else "")
+    pace = f" --pace {options.stack.pace:g}" if options.stack.pace is not None else ""
+    return layouts + (" --real-robot" if options.real_robot else "") + pace
 
 
 def record_outcome(
@@ -292,10 +297,35 @@ def summarize(outcomes: list[TrialOutcome], levels: dict[str, float], seed: int)
             for o in outcomes
             if not o.success
         ],
+        "remaining_time": remaining_time_summary(outcomes),
         # infrastructure, not the robot: trials run again because their worker process died
         "rerun_trials": [{"seed": o.seed, "lost_runs": o.lost_runs} for o in outcomes if o.lost_runs],
         "levels": levels,
         "outcomes": [asdict(o) for o in outcomes],
+    }
+
+
+def remaining_time_summary(outcomes: list[TrialOutcome]) -> dict[str, Any]:
+    """How well the steps' remaining-time estimates foretold their ends, over every finished step
+    (sila_labware.client.remaining_time): the share within the tolerance at every quarter, overall
+    and per step name."""
+    checks = [
+        RemainingCheck(check["step"], check["duration_s"], tuple(check["errors"]))
+        for outcome in outcomes
+        for check in outcome.remaining
+    ]
+    names = list(dict.fromkeys(check.step for check in checks if check.judged))
+    return {
+        "tolerance": remaining_time.TOLERANCE,
+        "quarters": list(remaining_time.QUARTERS),
+        "shortest_judged_s": remaining_time.SHORTEST_JUDGED_S,
+        "steps": sum(check.judged for check in checks),
+        "within": sum(check.within for check in checks if check.judged),
+        "share_within": remaining_time.share_within(checks),
+        "by_step": {
+            name: remaining_time.share_within([check for check in checks if check.step == name])
+            for name in names
+        },
     }
 
 
@@ -326,6 +356,14 @@ def format_table(summary: dict[str, Any]) -> str:
         f"placement error of delivered plates: median {summary['placement_error_mm_median']:.1f} mm, "
         f"max {summary['placement_error_mm_max']:.1f} mm",
     ]
+    estimates = summary.get("remaining_time")
+    if estimates and estimates["steps"]:
+        worst = min(estimates["by_step"].items(), key=lambda item: item[1])
+        lines.append(
+            f"remaining-time estimates within {100 * estimates['tolerance']:.0f} % of the step at each "
+            f"quarter: {estimates['within']} of {estimates['steps']} steps "
+            f"({100 * estimates['share_within']:.1f} %); least often: {worst[0]} ({100 * worst[1]:.0f} %)"
+        )
     reruns = summary.get("rerun_trials", [])
     if reruns:
         seeds = ", ".join(str(rerun["seed"]) for rerun in reruns)

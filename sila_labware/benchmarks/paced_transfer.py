@@ -6,9 +6,9 @@
 Why: at `--pace 1` a client should see a real robot's timing. Two figures say whether it does:
 - the transfer's wall time against its simulated time (the robot's /robot_state clock): their
   ratio should be the pace, idle time between the steps included;
-- the remaining time the robot server reports for GetLabware and PutLabware when the command is
-  about half done, against what really remained (the wall time from that report to the step's
-  end): SiLA remaining times are wall seconds, converted by the bridge at the robot's pace.
+- the remaining time the servers report for each step at each quarter of its duration, against
+  what really remained (sila_labware.client.remaining_time): SiLA remaining times are wall
+  seconds, converted by the bridge at the robot's pace.
 
 A benchmark, not a test: the figures depend on the machine's load. Prints one JSON object with
 `--json`, else a few lines.
@@ -27,32 +27,13 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from sila_labware.client import StepProgress
-from sila_labware.client.sequence import GET_LABWARE, PUT_LABWARE
+from sila_labware.client.remaining_time import TOLERANCE, RemainingCheck, RemainingSampler, share_within
 from sila_labware.deployment.clients import transfer_client
 from sila_labware.deployment.stack import Deployment, DeploymentOptions
 
 logger = logging.getLogger(__name__)
 
 DEFAULT_WORLD = Path(__file__).resolve().parents[2] / "lab_description" / "worlds" / "default.yaml"
-WATCHED_STEPS = (GET_LABWARE, PUT_LABWARE)
-HALFWAY = 0.5
-
-
-@dataclass
-class RemainingAtHalfway:
-    """One watched step: what the server said remained near half way, and what did."""
-
-    step: str
-    progress: float
-    reported_s: float | None
-    real_s: float
-
-    @property
-    def error_fraction(self) -> float | None:
-        if self.reported_s is None or self.real_s <= 0:
-            return None
-        return (self.reported_s - self.real_s) / self.real_s
 
 
 @dataclass
@@ -60,7 +41,7 @@ class PacedTransferReport:
     pace: float
     sim_seconds: float = 0.0
     wall_seconds: float = 0.0
-    remaining: list[RemainingAtHalfway] = field(default_factory=list)
+    remaining: list[RemainingCheck] = field(default_factory=list)
 
     @property
     def sim_per_wall(self) -> float:
@@ -70,29 +51,8 @@ class PacedTransferReport:
         return {
             **asdict(self),
             "sim_per_wall": self.sim_per_wall,
-            "remaining": [{**asdict(r), "error_fraction": r.error_fraction} for r in self.remaining],
+            "remaining_share_within": share_within(self.remaining),
         }
-
-
-class ProgressSamples:
-    """An `on_progress` callback keeping every record of the watched steps with its wall time."""
-
-    def __init__(self) -> None:
-        self.records: dict[str, list[tuple[float, StepProgress]]] = {step: [] for step in WATCHED_STEPS}
-
-    def __call__(self, record: StepProgress) -> None:
-        if record.step in self.records:
-            self.records[record.step].append((time.monotonic(), record))
-
-    def at_halfway(self, step: str) -> RemainingAtHalfway | None:
-        """The running record nearest half way that carries an estimate, against the step's end."""
-        records = self.records[step]
-        ends = [wall for wall, record in records if record.done]
-        estimates = [(w, r) for w, r in records if not r.done and r.remaining_s is not None]
-        if not ends or not estimates:
-            return None
-        wall, record = min(estimates, key=lambda sample: abs(sample[1].progress - HALFWAY))
-        return RemainingAtHalfway(step, record.progress, record.remaining_s, ends[0] - wall)
 
 
 def run(
@@ -112,7 +72,7 @@ def run(
         nests = link.nest_readings()
         plate = next(n for n in nests if n.nest.station == source.name and n.occupied)
         free = next(n for n in nests if n.nest.station == destination.name and not n.occupied)
-        samples = ProgressSamples()
+        samples = RemainingSampler()
         report = PacedTransferReport(pace)
         wall_start, sim_start = time.monotonic(), link.robot_status().stamp_s
         with transfer_client(deployment) as client:
@@ -124,7 +84,7 @@ def run(
             )
         report.wall_seconds = time.monotonic() - wall_start
         report.sim_seconds = link.robot_status().stamp_s - sim_start
-        report.remaining = [m for step in WATCHED_STEPS if (m := samples.at_halfway(step)) is not None]
+        report.remaining = samples.checks
         return report
     finally:
         deployment.stop()
@@ -159,11 +119,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         f"pace {report.pace:g}: {report.sim_seconds:.1f} s simulated in {report.wall_seconds:.1f} s wall "
         f"(ratio {report.sim_per_wall:.3f})\n"
     )
-    for sample in report.remaining:
-        reported = "none" if sample.reported_s is None else f"{sample.reported_s:.1f} s"
+    for check in (check for check in report.remaining if check.judged):
+        errors = ", ".join("no estimate" if e is None else f"{100 * e:+.0f} %" for e in check.errors)
+        verdict = "within" if check.within else "OUTSIDE"
         sys.stdout.write(
-            f"{sample.step} at {100 * sample.progress:.0f} %: remaining reported {reported}, "
-            f"real {sample.real_s:.1f} s\n"
+            f"{check.step} ({check.duration_s:.1f} s): remaining time at its quarters off by {errors} "
+            f"of the step ({verdict} {100 * TOLERANCE:.0f} %)\n"
         )
     return 0
 

@@ -27,6 +27,7 @@ from ros_bridge.errors import BridgeError
 from ros_bridge.robot_link import RobotLink
 from sila_labware.client import StepProgress
 from sila_labware.client.console import ProgressLine
+from sila_labware.client.remaining_time import RemainingCheck, RemainingSampler
 from sila_labware.deployment.clients import transfer_client
 from sila_labware.deployment.plate_names import plate_named_at
 from sila_labware.deployment.stack import Deployment
@@ -52,6 +53,7 @@ class DemoReport:
     sim_seconds: float = 0.0
     wall_seconds: float = 0.0
     steps: list[StepTiming] = field(default_factory=list)
+    remaining: list[RemainingCheck] = field(default_factory=list)  # the estimates' errors per step
     labware_id: str = ""
     source: str = ""
     destination: str = ""
@@ -62,16 +64,19 @@ class DemoReport:
 
 
 class StepClock:
-    """An `on_progress` callback: times every finished step in wall and simulated seconds, and
-    draws the progress line. Simulated time is the robot's clock, read when a step begins and ends."""
+    """An `on_progress` callback: times every finished step in wall and simulated seconds, checks
+    its remaining-time estimates (`remaining`), and draws the progress line. Simulated time is the
+    robot's clock, read when a step begins and ends."""
 
     def __init__(self, link: RobotLink, progress_line: ProgressLine) -> None:
         self._link = link
         self._progress_line = progress_line
         self._sim_started_s = 0.0
         self.steps: list[StepTiming] = []
+        self.remaining = RemainingSampler()
 
     def __call__(self, record: StepProgress) -> None:
+        self.remaining(record)
         if record.elapsed_s == 0.0:  # the step's first record, before its commands are sent
             self._sim_started_s = self._link.robot_status().stamp_s
         if record.done:
@@ -129,6 +134,7 @@ def run_demo(deployment: Deployment, progress_stream: TextIO | None = sys.stderr
         if progress_stream is not None:
             progress_stream.write(f"\nfailed: {report.error}\n")
     report.steps = clock.steps
+    report.remaining = clock.remaining.checks
     report.wall_seconds = time.monotonic() - wall_start
     try:
         report.sim_seconds = link.robot_status().stamp_s - sim_start

@@ -172,6 +172,9 @@ def test_demo_json_reports_the_transfer_and_records_pictures(tmp_path: Path) -> 
     }
     assert len(report["steps"]) == 6
     assert all(set(step) == {"name", "sim_seconds", "wall_seconds"} for step in report["steps"])
+    # each step's remaining-time estimates, checked at its quarters (the figure is the campaigns')
+    assert [check["step"] for check in report["remaining"]] == [step["name"] for step in report["steps"]]
+    assert all(len(check["errors"]) == 3 for check in report["remaining"])
     assert report["success"] is True, report
     assert (report["error"], report["error_kind"], report["exit_code"]) == ("", "", 0)
     assert done.returncode == 0, done.stderr[-2000:]
