@@ -63,26 +63,21 @@ from robot_port.tiago_interfaces import (
     UNDOCK_ROBOT,
     controller_action,
 )
-from robot_port.types import JOINT_GROUPS, CameraFrame, CameraIntrinsics, JointTrajectory, LaserScan, Pose2D
+from robot_port.types import JOINT_GROUPS, CameraFrame, JointTrajectory, LaserScan, Pose2D
 from tiago_description import robot_model as rm
 from tiago_description import transforms as tf
-from tiago_description.fixed_frames import FixedFrame, chain
 from tiago_description.joint_limits import velocity_limits
 from tiago_ros_hardware.base_loops import drive_loop, velocity_loop
+from tiago_ros_hardware.camera_messages import decoded, frame_pair
 from tiago_ros_hardware.executions import FailedExecution, GoalsExecution, LoopExecution
+from tiago_ros_hardware.frames import RobotFrames, yaw_of
 from tiago_ros_hardware.topics import TopicHistory, stamp_seconds
 from tiago_ros_hardware.trajectory_goals import controller_goals, duration_msg
 
 READING_TIMEOUT_S = 30.0
 """Wall seconds a reading may wait for its topic before the robot counts as gone."""
-MAP_FRAME, ODOM_FRAME, BASE_FRAME = "map", "odom", "base_footprint"
 NAVIGATION_SPEED_MPS = 0.5  # for the time-left estimate of a navigation goal only
 DOCKING_S = 8.0  # for the time-left estimate of docking and undocking only
-
-
-def yaw_of(orientation: Any) -> float:
-    q = orientation
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
 
 
 class RosHardware:
@@ -99,9 +94,7 @@ class RosHardware:
         self._busy: dict[str, Execution] = {}
         self._clock_s: float | None = None
         self._clock_changed = threading.Condition()
-        self._correction: Pose2D = (0.0, 0.0, 0.0)
-        self._fixed: dict[str, FixedFrame] = {}  # the robot's fixed frames by child, from /tf_static
-        self._fixed_changed = threading.Condition()
+        self.frames = RobotFrames(READING_TIMEOUT_S)  # localisation's correction, the fixed frames
         self.joints = TopicHistory(JOINT_STATES)
         self.odom = TopicHistory(ODOMETRY)
         self.scans = TopicHistory(LASER)
@@ -113,44 +106,39 @@ class RosHardware:
         self._subscribe(Clock, "/clock", self._on_clock, reliable)
         self._subscribe(JointState, JOINT_STATES, self._on_joints, reliable)
         self._subscribe(Odometry, ODOMETRY, self._on_odometry, reliable)
-        self._subscribe(TFMessage, TF, self._on_tf, reliable)
+        self._subscribe(TFMessage, TF, self.frames.on_tf, reliable)
         latched = QoSProfile(
             depth=10, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
         )
-        self._subscribe(TFMessage, TF_STATIC, self._on_tf_static, latched)
+        self._subscribe(TFMessage, TF_STATIC, self.frames.on_tf_static, latched)
         self._subscribe(BatteryState, BATTERY_STATE, self.battery.add, reliable)
         self._settled = {"joints": 0, "odom": 0, "battery": 0}  # counts after which readings show it at rest
         self.cmd_vel = node.create_publisher(Twist, CMD_VEL, reliable)
+        self.actions: dict[str, ActionClient] = {}  # every action the adapter sends goals to, by name
         self.controllers = {
-            group: ActionClient(
-                node, FollowJointTrajectory, controller_action(group), callback_group=self._group
-            )
-            for group in JOINT_GROUPS
+            group: self._action(FollowJointTrajectory, controller_action(group)) for group in JOINT_GROUPS
         }
-        self.navigation = ActionClient(node, NavigateToPose, NAVIGATE_TO_POSE, callback_group=self._group)
-        self.docking = ActionClient(node, DockRobot, DOCK_ROBOT, callback_group=self._group)
-        self.undocking = ActionClient(node, UndockRobot, UNDOCK_ROBOT, callback_group=self._group)
-        self.named_motions = ActionClient(node, PlayMotion2, PLAY_MOTION2, callback_group=self._group)
+        self.navigation = self._action(NavigateToPose, NAVIGATE_TO_POSE)
+        self.docking = self._action(DockRobot, DOCK_ROBOT)
+        self.undocking = self._action(UndockRobot, UNDOCK_ROBOT)
+        self.named_motions = self._action(PlayMotion2, PLAY_MOTION2)
         self.limits = velocity_limits()
 
     def wait_until_ready(self, timeout_s: float = READING_TIMEOUT_S) -> None:
         """Return once every action server the adapter sends goals to answers and the joints,
         odometry (and, on a simulator, the clock) have been heard; else HardwareUnavailable naming
         what is missing. Why: a goal sent before its server is discovered can be lost unanswered."""
-        clients = {
-            **{controller_action(group): client for group, client in self.controllers.items()},
-            NAVIGATE_TO_POSE: self.navigation,
-            DOCK_ROBOT: self.docking,
-            UNDOCK_ROBOT: self.undocking,
-            PLAY_MOTION2: self.named_motions,
-        }
-        for name, client in clients.items():
+        for name, client in self.actions.items():
             if not client.wait_for_server(timeout_sec=timeout_s):
                 raise HardwareUnavailable(f"no action server {name} within {timeout_s:.0f} s")
         for history in (self.joints, self.odom):
             history.after(0, timeout_s)  # HardwareUnavailable names the topic
         if self.simulated_clock:
             self.now()
+
+    def _action(self, kind: Any, name: str) -> ActionClient:
+        self.actions[name] = ActionClient(self.node, kind, name, callback_group=self._group)
+        return self.actions[name]
 
     def _subscribe(self, kind: Any, topic: str, callback: Any, qos: QoSProfile) -> None:
         self.node.create_subscription(kind, topic, callback, qos, callback_group=self._group)
@@ -169,39 +157,6 @@ class RosHardware:
         planar = (float(pose.position.x), float(pose.position.y), yaw_of(pose.orientation))
         twist = message.twist.twist
         self.odom.add((planar, (float(twist.linear.x), float(twist.angular.z))), stamp_seconds(message))
-
-    def _on_tf(self, message: TFMessage) -> None:
-        """Localisation's map -> odom, from the robot's /tf (other transforms are not needed)."""
-        for stamped in message.transforms:
-            if (stamped.header.frame_id, stamped.child_frame_id) == (MAP_FRAME, ODOM_FRAME):
-                t = stamped.transform
-                self._correction = (float(t.translation.x), float(t.translation.y), yaw_of(t.rotation))
-
-    def _on_tf_static(self, message: TFMessage) -> None:
-        """The robot's fixed frames (robot_state_publisher sends them once, latched)."""
-        with self._fixed_changed:
-            for stamped in message.transforms:
-                t = stamped.transform
-                transform = tf.from_pose(
-                    (t.translation.x, t.translation.y, t.translation.z),
-                    (t.rotation.x, t.rotation.y, t.rotation.z, t.rotation.w),
-                )
-                self._fixed[stamped.child_frame_id] = FixedFrame(
-                    stamped.header.frame_id, stamped.child_frame_id, transform
-                )
-            self._fixed_changed.notify_all()
-
-    def _mount(self, frame: str) -> Pose2D:
-        """Where `frame` sits on the base (x, y, yaw in base_footprint), from /tf_static."""
-        with self._fixed_changed:
-            found = self._fixed_changed.wait_for(
-                lambda: chain(self._fixed, BASE_FRAME, frame) is not None, READING_TIMEOUT_S
-            )
-            if not found:
-                raise HardwareUnavailable(f"no fixed frames from {BASE_FRAME} to {frame} on {TF_STATIC}")
-            transform = chain(self._fixed, BASE_FRAME, frame)
-        assert transform is not None
-        return float(transform[0, 3]), float(transform[1, 3]), tf.yaw_of(transform)
 
     # -- clock and readings --------------------------------------------------------------------
     def now(self) -> float:
@@ -234,7 +189,7 @@ class RosHardware:
         return {"joints": self.joints, "odom": self.odom, "battery": self.battery}
 
     def pose_estimate(self) -> Pose2D:
-        return tf.compose_planar(self._correction, self.odometry())
+        return tf.compose_planar(self.frames.correction, self.odometry())
 
     def is_docked(self) -> bool:
         state = self.battery.after(self._settled["battery"], READING_TIMEOUT_S)[1]
@@ -253,7 +208,7 @@ class RosHardware:
             angle_increment=float(message.angle_increment),
             range_min=float(message.range_min),
             range_max=float(message.range_max),
-            mount=self._mount(message.header.frame_id),
+            mount=self.frames.mount(message.header.frame_id),
             odometry=odometry[0] if odometry is not None else self.odometry(),
             stamp_s=stamp,
         )
@@ -265,34 +220,14 @@ class RosHardware:
             (CAMERA_DEPTH, Image, self.depths),
             (CAMERA_INFO, CameraInfo, self.infos),
         ):
-            stamp, image, depth = self._frame_pair(settled)
+            stamp, image, depth = frame_pair(self.images, self.depths, settled, READING_TIMEOUT_S)
             _, info = self.infos.newer_than(stamp - 1e-9, READING_TIMEOUT_S)  # the same intrinsics always
-        rgb = np.frombuffer(bytes(image.data), dtype=np.uint8).reshape(image.height, image.width, 3)
-        metres = np.frombuffer(bytes(depth.data), dtype=np.float32).reshape(depth.height, depth.width)
-        k = info.k
-        intrinsics = CameraIntrinsics(
-            width=info.width, height=info.height, fx=k[0], fy=k[4], cx=k[2], cy=k[5]
-        )
+        rgb, metres, intrinsics = decoded(image, depth, info)
         joints = self.joints.at(stamp) or self.joint_positions()
         odometry = self.odom.at(stamp)
         return CameraFrame(
-            rgb.copy(),
-            metres.copy(),
-            intrinsics,
-            dict(joints),
-            odometry[0] if odometry else self.odometry(),
-            stamp,
+            rgb, metres, intrinsics, dict(joints), odometry[0] if odometry else self.odometry(), stamp
         )
-
-    def _frame_pair(self, since_s: float) -> tuple[float, Any, Any]:
-        """A colour image rendered after `since_s` and the depth image of the same stamp (the two
-        topics' first messages may arrive for different frames)."""
-        while True:
-            stamp, image = self.images.newer_than(since_s - 1e-9, READING_TIMEOUT_S)
-            depth_stamp, depth = self.depths.newer_than(stamp - 1e-9, READING_TIMEOUT_S)
-            if abs(depth_stamp - stamp) < 1e-6:
-                return stamp, image, depth
-            since_s = depth_stamp  # the depth is of a later frame: take that frame's pair
 
     @contextmanager
     def _listening(self, *topics: tuple[str, Any, TopicHistory]) -> Iterator[None]:
@@ -430,12 +365,9 @@ class RosHardware:
         )
 
     def play_motion(self, key: str, skip_planning: bool = False, expected_s: float = 5.0) -> Execution:
-        """A named motion of the robot's play_motion2 (`key` as its motions file names it), with
-        the arms, the torso and the head claimed while it plays. Not a port method: the skills time
-        their own keyframes and chain them with tool moves (docs/reference/robot-interfaces.md);
-        this is for a lab's start-up and tools. `skip_planning` as play_motion2's goal: False lets
-        a robot with MoveIt plan the approach to the first row (PAL's advice); `expected_s` is
-        for the time-left estimate only."""
+        """A named motion of the robot's play_motion2, the arms, torso and head claimed meanwhile;
+        for a lab's tools, not the port's (the skills time their own keyframes). `skip_planning`
+        False lets MoveIt plan the approach (PAL's advice); `expected_s`: the time-left estimate."""
         goal = PlayMotion2.Goal(motion_name=key, skip_planning=skip_planning)
         sent = [(PLAY_MOTION2, self.named_motions, goal)]
         return self._claim(

@@ -297,35 +297,13 @@ def summarize(outcomes: list[TrialOutcome], levels: dict[str, float], seed: int)
             for o in outcomes
             if not o.success
         ],
-        "remaining_time": remaining_time_summary(outcomes),
+        "remaining_time": remaining_time.summary(
+            [RemainingCheck.from_dict(check) for outcome in outcomes for check in outcome.remaining]
+        ),
         # infrastructure, not the robot: trials run again because their worker process died
         "rerun_trials": [{"seed": o.seed, "lost_runs": o.lost_runs} for o in outcomes if o.lost_runs],
         "levels": levels,
         "outcomes": [asdict(o) for o in outcomes],
-    }
-
-
-def remaining_time_summary(outcomes: list[TrialOutcome]) -> dict[str, Any]:
-    """How well the steps' remaining-time estimates foretold their ends, over every finished step
-    (sila_labware.client.remaining_time): the share within the tolerance at every quarter, overall
-    and per step name."""
-    checks = [
-        RemainingCheck(check["step"], check["duration_s"], tuple(check["errors"]))
-        for outcome in outcomes
-        for check in outcome.remaining
-    ]
-    names = list(dict.fromkeys(check.step for check in checks if check.judged))
-    return {
-        "tolerance": remaining_time.TOLERANCE,
-        "quarters": list(remaining_time.QUARTERS),
-        "shortest_judged_s": remaining_time.SHORTEST_JUDGED_S,
-        "steps": sum(check.judged for check in checks),
-        "within": sum(check.within for check in checks if check.judged),
-        "share_within": remaining_time.share_within(checks),
-        "by_step": {
-            name: remaining_time.share_within([check for check in checks if check.step == name])
-            for name in names
-        },
     }
 
 

@@ -15,6 +15,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 from sila_labware.client.steps import StepProgress
 
@@ -34,6 +35,11 @@ class RemainingCheck:
     step: str
     duration_s: float
     errors: tuple[float | None, ...]
+
+    @classmethod
+    def from_dict(cls, fields: dict[str, Any]) -> RemainingCheck:
+        """From `dataclasses.asdict` of one (a campaign keeps them so, in JSON)."""
+        return cls(fields["step"], fields["duration_s"], tuple(fields["errors"]))
 
     @property
     def judged(self) -> bool:
@@ -84,3 +90,18 @@ def share_within(checks: Sequence[RemainingCheck]) -> float:
     judged)."""
     judged = [check for check in checks if check.judged]
     return sum(check.within for check in judged) / len(judged) if judged else 0.0
+
+
+def summary(checks: Sequence[RemainingCheck]) -> dict[str, Any]:
+    """The share of judged steps within the tolerance at every quarter, overall and per step name."""
+    judged = [check for check in checks if check.judged]
+    names = list(dict.fromkeys(check.step for check in judged))
+    return {
+        "tolerance": TOLERANCE,
+        "quarters": list(QUARTERS),
+        "shortest_judged_s": SHORTEST_JUDGED_S,
+        "steps": len(judged),
+        "within": sum(check.within for check in judged),
+        "share_within": share_within(judged),
+        "by_step": {name: share_within([check for check in judged if check.step == name]) for name in names},
+    }

@@ -33,8 +33,8 @@ from tiago_description import robot_model as rm
 from tiago_description import transforms as tf
 from tiago_description.joint_limits import velocity_limits
 from tiago_description.motion_library import load_motions
-from tiago_description.named_motions import named_motions
 from tiago_ros_hardware.hardware import RosHardware
+from tiago_sim.sim_node.named_motions import named_motions
 
 WAIT_S = 120.0
 
@@ -195,14 +195,14 @@ def test_the_pose_estimate_takes_localisations_correction_from_tf(
 
     def agree() -> bool:  # localisation may correct meanwhile: compare the latest of both, again
         caller.spin_for(0.1)
-        return bool(np.allclose(hardware._correction, simulators(), atol=1e-9))
+        return bool(np.allclose(hardware.frames.correction, simulators(), atol=1e-9))
 
     caller.wait_for(
         agree, 30.0, "the adapter's correction from /tf to be the simulator's (re-sent every 0.5 s)"
     )
     correction = simulators()
     assert any(abs(v) > 1e-9 for v in correction), "an identity correction would prove nothing"
-    expected = tf.compose_planar(hardware._correction, hardware.odometry())
+    expected = tf.compose_planar(hardware.frames.correction, hardware.odometry())
     assert np.allclose(hardware.pose_estimate(), expected, atol=1e-3)
 
 

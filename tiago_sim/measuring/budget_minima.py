@@ -14,7 +14,8 @@ from collections.abc import Iterator, Mapping, Sequence
 
 from robot_port.trajectory_timing import RAMP_S, trapezoid_duration
 from tiago_description import robot_model as rm
-from tiago_sim.physics.base_controller import _profile_s, wrap_angle
+from tiago_sim.physics.base_controller import wrap_angle
+from tiago_sim.physics.drive_timing import rest_to_rest_s
 
 FINGER_PREFIX = "gripper_"  # finger joints move with the gripper command, not on a trajectory
 SHORTEST_SEGMENT_M = 0.001  # a drive's segment shorter than this is no segment
@@ -61,8 +62,8 @@ def drive_min_s(
     heading = start_yaw + sum(turn for _, turn in legs)
     turned = sum(abs(turn) for _, turn in legs) + abs(wrap_angle(end_yaw - heading))
     length = sum(segment for segment, _ in legs)
-    driving = _profile_s(length, rm.MAX_LINEAR_ACCEL, rm.MAX_LINEAR_SPEED) if length > 0 else 0.0
-    turning = _profile_s(turned, rm.MAX_ANGULAR_ACCEL, rm.MAX_ANGULAR_SPEED) if turned > 0 else 0.0
+    driving = rest_to_rest_s(length, rm.MAX_LINEAR_ACCEL, rm.MAX_LINEAR_SPEED) if length > 0 else 0.0
+    turning = rest_to_rest_s(turned, rm.MAX_ANGULAR_ACCEL, rm.MAX_ANGULAR_SPEED) if turned > 0 else 0.0
     return max(driving, turning), length, turned
 
 

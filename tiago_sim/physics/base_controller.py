@@ -18,13 +18,13 @@ from lab_description.world import Pose2D
 from tiago_description import robot_model as rm
 from tiago_description.transforms import compose_planar as compose
 from tiago_description.transforms import invert_planar as invert
+from tiago_sim.physics.drive_timing import BLEND_ANGLE, drive_duration_s
 from tiago_sim.physics.motion import CANCELED, Motion, SequenceMotion
 from tiago_sim.physics.robot_body import RobotBody
 
 POSITION_TOLERANCE = 0.01  # m
 YAW_TOLERANCE = 0.01  # rad
 HEADING_GAIN = 2.5
-BLEND_ANGLE = 0.3  # rad: the drive starts once the heading is this close; the heading loop finishes the turn
 # How fast localisation's correction may move the believed pose while a drive runs: a typical
 # correction (under 1 cm, 0.3 deg) is in within 0.2 s; a large one is spread over seconds, which
 # the drive's heading loop (gain 2.5 /s) follows without a kink. At rest it applies at once.
@@ -44,26 +44,6 @@ def _ramp(current: float, desired: float, max_change: float) -> float:
 def _speed_for_distance(distance: float, accel: float, max_speed: float) -> float:
     """Largest speed from which the remaining distance suffices to stop."""
     return min(max_speed, math.sqrt(2.0 * accel * max(distance, 0.0)))
-
-
-def _profile_s(amount: float, accel: float, max_speed: float) -> float:
-    """Time to cover `amount` (m or rad) from rest to rest with a trapezoidal speed profile."""
-    amount = abs(amount)
-    if amount * accel >= max_speed**2:
-        return amount / max_speed + max_speed / accel
-    return 2.0 * math.sqrt(amount / accel)
-
-
-SETTLE_S = 0.5  # s: the heading loop closes its last millimetres and milliradians
-
-
-def drive_duration_s(turn_rad: float, distance_m: float, align_rad: float, speed: float) -> float:
-    """How long a drive takes with TIAGo's limits: turn to the bearing, drive, turn to the goal
-    heading (each at 80 % of the acceleration limits, as DriveMotion commands them)."""
-    turning = _profile_s(turn_rad, rm.MAX_ANGULAR_ACCEL * 0.8, rm.MAX_ANGULAR_SPEED)
-    aligning = _profile_s(align_rad, rm.MAX_ANGULAR_ACCEL * 0.8, rm.MAX_ANGULAR_SPEED)
-    driving = _profile_s(distance_m, rm.MAX_LINEAR_ACCEL * 0.8, speed)
-    return turning + driving + aligning + SETTLE_S
 
 
 class DiffDriveBase:
@@ -238,10 +218,16 @@ class DriveMotion(Motion):
         moving = distance > POSITION_TOLERANCE * 2
         bearing = math.atan2(self.goal[1] - y, self.goal[0] - x) + (math.pi if self.reverse else 0.0)
         if self.phase == "aligning" or not moving:
-            return drive_duration_s(0.0, 0.0, wrap_angle(self.goal[2] - yaw), self.speed)
+            error = wrap_angle(self.goal[2] - yaw)
+            towards = math.copysign(1.0, error) * self.base.w
+            return drive_duration_s(0.0, 0.0, error, self.speed, angular_speed=towards)
         align = wrap_angle(self.goal[2] - bearing)
-        turn = wrap_angle(bearing - yaw) if self.phase == "turning" else 0.0
-        return drive_duration_s(turn, distance, align, self.speed)
+        if self.phase == "turning":
+            turn = wrap_angle(bearing - yaw)
+            towards = math.copysign(1.0, turn) * self.base.w
+            return drive_duration_s(turn, distance, align, self.speed, angular_speed=towards)
+        forwards = -self.base.v if self.reverse else self.base.v
+        return drive_duration_s(0.0, distance, align, self.speed, linear_speed=forwards)
 
     def _turn_rate(self, error: float) -> float:
         return math.copysign(

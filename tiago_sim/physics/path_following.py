@@ -16,7 +16,8 @@ import math
 
 from tiago_description import robot_model as rm
 from tiago_sim.navigation.planner import Plan
-from tiago_sim.physics.base_controller import DiffDriveBase, DriveMotion, drive_duration_s, wrap_angle
+from tiago_sim.physics.base_controller import DiffDriveBase, DriveMotion, wrap_angle
+from tiago_sim.physics.drive_timing import drive_duration_s
 from tiago_sim.physics.motion import SequenceMotion
 
 TURN_WEIGHT_M = 0.1

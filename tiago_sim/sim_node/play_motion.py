@@ -2,7 +2,7 @@
 
 Why: PAL's play_motion2 node runs beside a TIAGo++'s controllers and plays a motion by name
 (play_motion2_msgs/action/PlayMotion2), listing its motions and whether one is ready on two
-services. The simulator plays the robot's motion library (tiago_description.named_motions) the
+services. The simulator plays the robot's motion library (tiago_sim.sim_node.named_motions) the
 same way: as play_motion2 does, it is a client of the controllers' FollowJointTrajectory actions
 (one goal per controller, sent together), so a motion shares the controllers' rules (a goal
 preempts a running one; a cancel stops the joints where they are). Not modelled: play_motion2's
@@ -34,8 +34,8 @@ from robot_port.tiago_interfaces import IS_MOTION_READY, LIST_MOTIONS, PLAY_MOTI
 from robot_port.types import JOINT_GROUPS
 from tiago_description import robot_model as rm
 from tiago_description.joint_limits import velocity_limits
-from tiago_description.named_motions import NamedMotion, TimedRows
 from tiago_sim.sim_node.action_server import cancellable_server
+from tiago_sim.sim_node.named_motions import NamedMotion, TimedRows
 from tiago_sim.sim_node.sim_thread import SimThread
 
 log = logging.getLogger(__name__)

@@ -18,11 +18,11 @@ from rclpy.node import Node
 from lab_description.world import World
 from tiago_description.fixed_frames import fixed_frames
 from tiago_description.motion_library import MotionLibrary
-from tiago_description.named_motions import named_motions
 from tiago_description.robot_model import build_urdf
 from tiago_sim.sim_node.base_interfaces import BaseVelocityInput, DockingServers, NavigateToPoseServer
 from tiago_sim.sim_node.controllers import TrajectoryControllers
 from tiago_sim.sim_node.localisation_topics import LocalisationTopics
+from tiago_sim.sim_node.named_motions import named_motions
 from tiago_sim.sim_node.navigation import Navigation
 from tiago_sim.sim_node.play_motion import PlayMotion2Server
 from tiago_sim.sim_node.sim_thread import SimThread
