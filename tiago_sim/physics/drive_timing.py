@@ -56,6 +56,12 @@ def profile_s(
     return (peak - start) / accel_up + cruise / peak + (peak - end_speed) / accel_down
 
 
+def _turn_s(angle: float, start_speed: float, stop_short: float = 0.0) -> float:
+    """A turn on the spot: speeding up at the angular limit, braking at 80 % of it."""
+    accel = rm.MAX_ANGULAR_ACCEL
+    return profile_s(angle, accel, accel * 0.8, rm.MAX_ANGULAR_SPEED, start_speed, stop_short)
+
+
 SETTLE_S = 0.1
 """s: the heading loop closes its last millimetres and milliradians (0.05 s measured at the end of
 a drive in the default lab; 0.5 s here made every segment's estimate that much long)."""
@@ -74,22 +80,9 @@ def drive_duration_s(
     up at the base's limits and braking at 80 % of them. `linear_speed` and `angular_speed` are the
     base's speeds now, towards the phase under way (the drive or the turn to the bearing)."""
     moving = distance_m > 0.0
-    turning = profile_s(
-        turn_rad,
-        rm.MAX_ANGULAR_ACCEL,
-        rm.MAX_ANGULAR_ACCEL * 0.8,
-        rm.MAX_ANGULAR_SPEED,
-        start_speed=angular_speed if turn_rad else 0.0,
-        stop_short=BLEND_ANGLE if moving else 0.0,
-    )
+    turning = _turn_s(turn_rad, angular_speed if turn_rad else 0.0, BLEND_ANGLE if moving else 0.0)
     driving = profile_s(
         distance_m, rm.MAX_LINEAR_ACCEL, rm.MAX_LINEAR_ACCEL * 0.8, speed, start_speed=linear_speed
     )
-    aligning = profile_s(
-        align_rad,
-        rm.MAX_ANGULAR_ACCEL,
-        rm.MAX_ANGULAR_ACCEL * 0.8,
-        rm.MAX_ANGULAR_SPEED,
-        start_speed=0.0 if moving or turn_rad else angular_speed,
-    )
+    aligning = _turn_s(align_rad, 0.0 if moving or turn_rad else angular_speed)
     return turning + driving + aligning + SETTLE_S
