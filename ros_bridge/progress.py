@@ -18,6 +18,12 @@ from dataclasses import dataclass
 
 from labware_model.progress import MonotonicProgress
 
+RUNNING_GOAL_LEAST_REMAINING_S = 0.5
+"""Wall seconds: the least remaining time a command reports while a goal of it still runs. A SiLA
+client counts the last estimate down by itself and stops at 0; the robot side's next report comes
+a feedback period later (more on a busy machine), so an estimate closer to 0 than that showed a
+client 0 while the base still settled (CI, after drive estimates stopped padding each segment)."""
+
 ProgressReport = Callable[[float, float | None], None]
 """Called with (fraction done 0..1, estimated remaining time in wall seconds, or None where there
 is no estimate: never 0 while work remains)."""
@@ -63,8 +69,11 @@ class CommandProgress:
         before the goal is done means none)."""
 
         def on_goal_progress(progress: GoalProgress) -> None:
-            known = last and (progress.remaining_time_s > 0.0 or progress.progress >= 1.0)
+            done = progress.progress >= 1.0
+            known = last and (progress.remaining_time_s > 0.0 or done)
             remaining = self._to_wall_s(progress.remaining_time_s) if known else None
+            if remaining is not None and not done:
+                remaining = max(remaining, RUNNING_GOAL_LEAST_REMAINING_S)
             self.report(start + (end - start) * progress.progress, remaining)
 
         return on_goal_progress

@@ -15,7 +15,12 @@ import pytest
 from ros_bridge.bluesky import ActionFailed, ActionStatus
 from ros_bridge.errors import BridgeError, BridgeTimeout, GoalAbandoned, GoalRejected
 from ros_bridge.goal_status import ActionGoal, ActionOutcome
-from ros_bridge.progress import CommandProgress, GoalProgress, MonotonicProgress
+from ros_bridge.progress import (
+    RUNNING_GOAL_LEAST_REMAINING_S,
+    CommandProgress,
+    GoalProgress,
+    MonotonicProgress,
+)
 
 ARRIVED = ActionOutcome(True, "", "arrived at reader_poi", "SUCCEEDED")
 BLOCKED = ActionOutcome(False, "PATH_BLOCKED", "no path to reader_poi", "ABORTED")
@@ -336,3 +341,16 @@ def test_the_bluesky_status_fails_with_the_goals_error_code_or_exception() -> No
     lost_goal.abort("robot side lost")
     with pytest.raises(GoalAbandoned, match="robot side lost"):
         lost.wait(timeout=1.0)
+
+
+def test_a_running_goal_never_reports_less_remaining_time_than_a_feedback_period() -> None:
+    """A SiLA client counts the last estimate down to 0 by itself: while the goal still runs, the
+    command says at least RUNNING_GOAL_LEAST_REMAINING_S, so the count never reaches 0 before the
+    robot's next report. The goal's end still says 0."""
+    reports: list[tuple[float, float | None]] = []
+    drive = CommandProgress(lambda fraction, remaining_s: reports.append((fraction, remaining_s))).step(
+        0.0, 1.0
+    )
+    drive(GoalProgress(0.97, "aligning", 0.1))
+    drive(GoalProgress(1.0, "done", 0.0))
+    assert reports == [(0.97, RUNNING_GOAL_LEAST_REMAINING_S), (1.0, 0.0)]

@@ -135,4 +135,5 @@ def test_bench_help_names_the_layout_and_worker_flags() -> None:
 def test_a_paced_campaigns_trial_replays_at_its_pace() -> None:
     stack = DeploymentOptions(world=DEFAULT_WORLD, port_base=57000, pace=1.0)
     assert replay_flags(CampaignOptions(stack, SEED, 1, default_level_values())) == " --pace 1"
-    assert trial_stack(CampaignOptions(stack, SEED, 1, default_level_values()), SEED + 1, worker=1).pace == 1.0
+    options = CampaignOptions(stack, SEED, 1, default_level_values())
+    assert trial_stack(options, SEED + 1, worker=1).pace == 1.0

@@ -180,7 +180,10 @@ def test_pace_is_set_at_run_time_and_refused_outside_its_range(cell: Cell) -> No
     lab.SetPace(Pace=2.0)
     assert lab.Pace.get() == 2.0
     started_wall, started_sim = time.monotonic(), lab.SimulatedTime.get()
-    time.sleep(2.0)
+    time.sleep(4.0)
     ratio = (lab.SimulatedTime.get() - started_sim) / (time.monotonic() - started_wall)
     lab.SetPace(Pace=0.0)
-    assert 1.5 < ratio < 2.5  # idle at the set pace (default idle: real time)
+    # idle at the set pace, not the default idle's real time (1.0). SimulatedTime is the last
+    # /robot_state's stamp, 0.5 s of wall time apart at most: each end may lag by one report, and a
+    # loaded CI run read 1.47 over 2 s
+    assert 1.3 < ratio < 2.7

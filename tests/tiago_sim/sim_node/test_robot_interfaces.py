@@ -41,8 +41,8 @@ from robot_port.tiago_interfaces import (
 from robot_port.types import JOINT_GROUPS
 from tests.helpers.ros_processes import RosCaller, running
 from tiago_description.motion_library import load_motions
-from tiago_sim.sim_node.named_motions import named_motions
 from tiago_description.robot_model import controller_joints
+from tiago_sim.sim_node.named_motions import named_motions
 
 HEAD = controller_action("head")
 TORSO = controller_action("torso")
