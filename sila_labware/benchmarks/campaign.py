@@ -335,7 +335,7 @@ def format_table(summary: dict[str, Any]) -> str:
         f"max {summary['placement_error_mm_max']:.1f} mm",
     ]
     estimates = summary.get("remaining_time")
-    if estimates and estimates["steps"]:
+    if estimates and estimates["steps"] and summary.get("pace"):  # unpaced, no wall-time estimate can hold
         worst = min(estimates["by_step"].items(), key=lambda item: item[1])
         lines.append(
             f"remaining-time estimates within {100 * estimates['tolerance']:.0f} % of the step at each "

@@ -243,6 +243,7 @@ def _run_and_report(args: argparse.Namespace, options: CampaignOptions) -> int:
     shown_levels = {level.flag.removeprefix("--"): levels[level.field] for level in LEVEL_FLAGS}
     summary = summarize(outcomes, shown_levels, first_seed)
     summary["jobs"] = options.jobs
+    summary["pace"] = options.stack.pace  # None: unpaced, where the remaining times are not judged
     summary["random_layouts"] = options.layouts_dir is not None and options.layouts_flag == "--random-layouts"
     summary["random_obstacles"] = (
         options.layouts_dir is not None and options.layouts_flag == "--random-obstacles"

@@ -202,8 +202,13 @@ def test_the_pose_estimate_takes_localisations_correction_from_tf(
     )
     correction = simulators()
     assert any(abs(v) > 1e-9 for v in correction), "an identity correction would prove nothing"
-    expected = tf.compose_planar(hardware.frames.correction, hardware.odometry())
-    assert np.allclose(hardware.pose_estimate(), expected, atol=1e-3)
+    # localisation corrects with every scan it matches: compare within one correction (the same
+    # correction before and after the reading; a loaded CI run read across two, 1 mm apart)
+    for _ in range(50):
+        before, believed, odometry = hardware.frames.correction, hardware.pose_estimate(), hardware.odometry()
+        if hardware.frames.correction == before:
+            break
+    assert np.allclose(believed, tf.compose_planar(before, odometry), atol=1e-3)
 
 
 def test_the_adapter_speaks_only_listed_interfaces_with_their_types(

@@ -3,8 +3,11 @@ against what really remained (sila_labware.client.remaining_time), on records as
 
 from __future__ import annotations
 
+from dataclasses import asdict
+
 import pytest
 
+from sila_labware.benchmarks.campaign import TrialOutcome, format_table, summarize
 from sila_labware.client.remaining_time import RemainingSampler, share_within
 from sila_labware.client.steps import StepProgress
 
@@ -59,3 +62,17 @@ def test_steps_shorter_than_a_second_are_not_judged() -> None:
     removed, get = sampler.checks
     assert not removed.judged and get.judged
     assert share_within(sampler.checks) == 1.0
+
+
+def test_a_campaigns_table_judges_the_estimates_only_when_it_ran_paced() -> None:
+    """Unpaced, the robot's clock races through motions and crawls while the software computes: no
+    wall-time estimate can hold, so the table says nothing of them (the JSON keeps the numbers)."""
+    sampler, now = sampler_with_clock()
+    feed(sampler, now, "Robot.GetLabware", [(0.0, 10.0), (10.0, None)])
+    outcome = TrialOutcome(
+        1, True, "", "", 60.0, 10.0, 1.0, 1.0, remaining=[asdict(c) for c in sampler.checks]
+    )
+    summary = summarize([outcome], {}, 1)
+    assert summary["remaining_time"]["within"] == 1
+    assert "remaining-time estimates" not in format_table({**summary, "pace": None})
+    assert "remaining-time estimates within 10 %" in format_table({**summary, "pace": 1.0})
