@@ -21,8 +21,8 @@ from labware_model.progress import MonotonicProgress
 RUNNING_GOAL_LEAST_REMAINING_S = 0.5
 """Wall seconds: the least remaining time a command reports while a goal of it still runs. A SiLA
 client counts the last estimate down by itself and stops at 0; the robot side's next report comes
-a feedback period later (more on a busy machine), so an estimate closer to 0 than that showed a
-client 0 while the base still settled (CI, after drive estimates stopped padding each segment)."""
+a feedback period later (more on a busy machine), so an estimate closer to 0 than that would show
+a client 0 while the base still settles."""
 
 ProgressReport = Callable[[float, float | None], None]
 """Called with (fraction done 0..1, estimated remaining time in wall seconds, or None where there

@@ -93,8 +93,7 @@ class GoalRunner:
         except BridgeError:
             logger.warning("%s: no end within %.0f s of the cancel", goal.action_name, self.waits.cancel_s)
         # Bounded by cancel_s, not state_report_s: a braking base reports its stand only once it
-        # stands, which on a busy machine at a real-time pace took longer than 2 s of wall time (a
-        # cancel answered while RobotState still read Navigating, in a CI run).
+        # stands, which on a busy machine at a real-time pace can take longer than 2 s of wall time.
         self.await_state(lambda status: status.at_rest, "the robot at rest", within_s=self.waits.cancel_s)
 
     def await_state(

@@ -203,7 +203,7 @@ def test_the_pose_estimate_takes_localisations_correction_from_tf(
     correction = simulators()
     assert any(abs(v) > 1e-9 for v in correction), "an identity correction would prove nothing"
     # localisation corrects with every scan it matches: compare within one correction (the same
-    # correction before and after the reading; a loaded CI run read across two, 1 mm apart)
+    # correction before and after the reading)
     for _ in range(50):
         before, believed, odometry = hardware.frames.correction, hardware.pose_estimate(), hardware.odometry()
         if hardware.frames.correction == before:

@@ -63,8 +63,8 @@ def _turn_s(angle: float, start_speed: float, stop_short: float = 0.0) -> float:
 
 
 SETTLE_S = 0.1
-"""s: the heading loop closes its last millimetres and milliradians (0.05 s measured at the end of
-a drive in the default lab; 0.5 s here made every segment's estimate that much long)."""
+"""s: the heading loop closes its last millimetres and milliradians (about 0.05 s at a drive's end;
+counted once per segment, so more here makes every segment's estimate that much long)."""
 
 
 def drive_duration_s(

@@ -1,8 +1,7 @@
 """A drive's remaining-time estimate against what the drive then takes, in simulated time.
 
 Why: the estimate is what navigation's feedback (and through it a SiLA command's remaining time)
-says; it summed each phase from rest, so the turn's hand-over to the drive and a half-second
-settle per segment made it 1.7 to 1.8 s (19 to 25 %) long in the default lab. Real PyBullet, the
+says, so it must follow the drive as DriveMotion makes it, phase by phase. Real PyBullet, the
 default lab, the planner's paths between its stations.
 """
 
