@@ -53,6 +53,7 @@ from sila_labware.deployment.cli_arguments import (
 )
 from sila_labware.deployment.connection_config import add_print_config_argument, print_servers, write_config
 from sila_labware.deployment.json_outcome import JsonOutput, UsageError, outcome_fields
+from sila_labware.deployment.robot_limits_file import robot_limits_problem, use_robot_limits
 from sila_labware.deployment.world_file import add_world_command, world_command, world_problems
 from sila_labware.servers.refusal_log import install_refusal_log_filter
 
@@ -133,6 +134,10 @@ def _validate(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None
         parser.error(problem)
     if args.command == "bench":
         validate_bench(parser, args)
+    if args.robot_limits is not None:
+        if problem := robot_limits_problem(args.robot_limits):
+            parser.error(f"--robot-limits: {problem}")
+        use_robot_limits(args.robot_limits)
     problems = world_problems(args.world)  # last: a child process, the slowest check
     if problems:
         parser.error("invalid world file: " + "\n".join(problems))

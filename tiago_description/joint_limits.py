@@ -1,7 +1,7 @@
-"""Each joint's velocity limit, from the robot model (the URDF the simulator builds its body from).
+"""Each joint's hardware velocity limit, from the robot model (the URDF the simulator builds its body from).
 
-Why one reader: the simulator's controllers, an adapter timing a robot's own controllers and the
-time budget all need the same limits (rad/s; m/s for the torso and the fingers).
+Why one reader: the limits a lab runs its robot with (`robot_limits`, which the simulator's controllers,
+the ROS adapter and the time budget use) may not exceed these (rad/s; m/s for the torso and the fingers).
 """
 
 from __future__ import annotations

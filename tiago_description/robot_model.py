@@ -39,6 +39,7 @@ DEG = math.pi / 180.0
 WHEEL_RADIUS = 0.0985
 WHEEL_SEPARATION = 0.4044
 BASE_RADIUS = 0.265
+# The base's hardware maxima; the limits a lab runs the robot with are robot_limits' (at most these).
 MAX_LINEAR_SPEED = 1.0
 MAX_ANGULAR_SPEED = 1.0
 MAX_LINEAR_ACCEL = 0.5

@@ -66,7 +66,7 @@ from robot_port.tiago_interfaces import (
 from robot_port.types import JOINT_GROUPS, CameraFrame, JointTrajectory, LaserScan, Pose2D
 from tiago_description import robot_model as rm
 from tiago_description import transforms as tf
-from tiago_description.joint_limits import velocity_limits
+from tiago_description.robot_limits import active_limits
 from tiago_ros_hardware.base_loops import drive_loop, velocity_loop
 from tiago_ros_hardware.camera_messages import decoded, frame_pair
 from tiago_ros_hardware.executions import FailedExecution, GoalsExecution, LoopExecution
@@ -122,7 +122,7 @@ class RosHardware:
         self.docking = self._action(DockRobot, DOCK_ROBOT)
         self.undocking = self._action(UndockRobot, UNDOCK_ROBOT)
         self.named_motions = self._action(PlayMotion2, PLAY_MOTION2)
-        self.limits = velocity_limits()
+        self.limits = dict(active_limits().joint_velocity)
 
     def wait_until_ready(self, timeout_s: float = READING_TIMEOUT_S) -> None:
         """Return once every action server the adapter sends goals to answers and the joints,
@@ -282,7 +282,7 @@ class RosHardware:
         group = f"gripper_{side}"
         fingers = rm.finger_joint_names(side)
         target = 0.0 if close else rm.FINGER_TRAVEL - 0.001
-        seconds = rm.FINGER_TRAVEL / rm.FINGER_SPEED
+        seconds = rm.FINGER_TRAVEL / active_limits().finger_speed
         goal = FollowJointTrajectory.Goal()
         goal.trajectory.joint_names = fingers
         point = JointTrajectoryPoint(positions=[target] * len(fingers), time_from_start=duration_msg(seconds))

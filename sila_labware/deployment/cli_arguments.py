@@ -30,6 +30,14 @@ def _add_robot_side(sub: argparse.ArgumentParser, default_world: Path) -> None:
     sub.add_argument("--log-dir", type=Path, default=None, help="write the robot side's output to files here")
     sub.add_argument("--ready-timeout", type=float, default=180.0, help="seconds to wait for the robot side")
     sub.add_argument("--verbose", action="store_true", help="log at INFO level")
+    sub.add_argument(
+        "--robot-limits",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="the robot's speed and acceleration limits (default: a TIAGo++ as shipped; "
+        "tiago_description/robot_limits.yaml shows the format)",
+    )
 
 
 def add_stack_arguments(sub: argparse.ArgumentParser, default_world: Path) -> None:

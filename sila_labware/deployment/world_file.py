@@ -14,8 +14,9 @@ import subprocess
 import sys
 from pathlib import Path
 
+from sila_labware.deployment.child_check import check_problems
+
 WORLD_CHECK_MODULE = "tiago_sim.inspection.world_check"
-CHECK_TIMEOUT_S = 60.0
 
 
 def add_world_command(subcommands: argparse._SubParsersAction, parser_class: type) -> None:
@@ -40,14 +41,4 @@ def world_command(args: argparse.Namespace) -> int:
 
 def world_problems(world: Path) -> list[str]:
     """Every problem `world check` finds in the file, one line each (`file: field: problem`)."""
-    done = subprocess.run(
-        [sys.executable, "-m", WORLD_CHECK_MODULE, str(world)],
-        capture_output=True,
-        text=True,
-        timeout=CHECK_TIMEOUT_S,
-        stdin=subprocess.DEVNULL,
-        check=False,
-    )
-    if done.returncode == 0:
-        return []
-    return done.stderr.strip().splitlines() or [f"{world}: world check exited with {done.returncode}"]
+    return check_problems(WORLD_CHECK_MODULE, [str(world)])

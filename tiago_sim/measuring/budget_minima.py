@@ -13,7 +13,7 @@ import math
 from collections.abc import Iterator, Mapping, Sequence
 
 from robot_port.trajectory_timing import RAMP_S, trapezoid_duration
-from tiago_description import robot_model as rm
+from tiago_description.robot_limits import active_limits
 from tiago_sim.physics.base_controller import wrap_angle
 from tiago_sim.physics.drive_timing import rest_to_rest_s
 
@@ -39,10 +39,10 @@ def joint_move_min_s(
     return trapezoid_duration(slowest, ramp_s), name
 
 
-def gripper_min_s(
-    start: Mapping[str, float], end: Mapping[str, float], speed: float = rm.FINGER_SPEED
-) -> float:
-    """Least time for the fingers' travel at their speed limit (the longer finger's travel)."""
+def gripper_min_s(start: Mapping[str, float], end: Mapping[str, float], speed: float | None = None) -> float:
+    """Least time for the fingers' travel at their speed limit (the longer finger's travel); `speed`
+    None: the fingers' limit."""
+    speed = active_limits().finger_speed if speed is None else speed
     travel = max((abs(end[j] - start[j]) for j in start.keys() & end.keys()), default=0.0)
     return travel / speed
 
@@ -62,8 +62,9 @@ def drive_min_s(
     heading = start_yaw + sum(turn for _, turn in legs)
     turned = sum(abs(turn) for _, turn in legs) + abs(wrap_angle(end_yaw - heading))
     length = sum(segment for segment, _ in legs)
-    driving = rest_to_rest_s(length, rm.MAX_LINEAR_ACCEL, rm.MAX_LINEAR_SPEED) if length > 0 else 0.0
-    turning = rest_to_rest_s(turned, rm.MAX_ANGULAR_ACCEL, rm.MAX_ANGULAR_SPEED) if turned > 0 else 0.0
+    limits = active_limits()
+    driving = rest_to_rest_s(length, limits.linear_accel, limits.linear_speed) if length > 0 else 0.0
+    turning = rest_to_rest_s(turned, limits.angular_accel, limits.angular_speed) if turned > 0 else 0.0
     return max(driving, turning), length, turned
 
 

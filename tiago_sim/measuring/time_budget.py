@@ -21,7 +21,7 @@ import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from tiago_description.joint_limits import velocity_limits
+from tiago_description.robot_limits import active_limits
 from tiago_sim.measuring.benchmark import GOAL_LINE
 from tiago_sim.measuring.budget_minima import (
     drive_min_s,
@@ -124,7 +124,7 @@ def goal_minimum(goal: Goal) -> tuple[float, str]:
         parts.append((drive_s, f"base {length:.2f} m, {math.degrees(turned):.0f} deg"))
     joints, fingers = split_joints({name: b - a for name, (a, b) in goal.joints.items()})
     moved = {name: change for name, change in joints.items() if abs(change) >= JOINT_AT_REST}
-    move_s, slowest = joint_move_min_s(dict.fromkeys(moved, 0.0), moved, velocity_limits())
+    move_s, slowest = joint_move_min_s(dict.fromkeys(moved, 0.0), moved, active_limits().joint_velocity)
     if slowest:
         unit = "m" if slowest.startswith("torso") else "rad"
         parts.append((move_s, f"{slowest} {abs(moved[slowest]):.2f} {unit} of {len(moved)} joints"))

@@ -16,6 +16,7 @@ import numpy as np
 
 from lab_description.world import Pose2D
 from tiago_description import robot_model as rm
+from tiago_description.robot_limits import active_limits
 from tiago_description.transforms import compose_planar as compose
 from tiago_description.transforms import invert_planar as invert
 from tiago_sim.physics.drive_timing import BLEND_ANGLE, drive_duration_s
@@ -106,8 +107,9 @@ class DiffDriveBase:
             self.map_from_odom, self.map_from_odom_target = target, None
 
     def command(self, v: float, w: float) -> None:
-        self.v_cmd = min(max(v, -rm.MAX_LINEAR_SPEED), rm.MAX_LINEAR_SPEED)
-        self.w_cmd = min(max(w, -rm.MAX_ANGULAR_SPEED), rm.MAX_ANGULAR_SPEED)
+        limits = active_limits()
+        self.v_cmd = min(max(v, -limits.linear_speed), limits.linear_speed)
+        self.w_cmd = min(max(w, -limits.angular_speed), limits.angular_speed)
 
     def protective_stop(self) -> None:
         """Cut the drive at once (a collision): velocity and command zero, the base held where it
@@ -127,8 +129,9 @@ class DiffDriveBase:
 
     def update(self, dt: float) -> None:
         """Before the physics step: accelerate towards the command and move the constraint pivot."""
-        self.v = _ramp(self.v, self.v_cmd, rm.MAX_LINEAR_ACCEL * dt)
-        self.w = _ramp(self.w, self.w_cmd, rm.MAX_ANGULAR_ACCEL * dt)
+        limits = active_limits()
+        self.v = _ramp(self.v, self.v_cmd, limits.linear_accel * dt)
+        self.w = _ramp(self.w, self.w_cmd, limits.angular_accel * dt)
         x, y, yaw = self.target
         mid_yaw = yaw + 0.5 * self.w * dt
         self.target = [
@@ -185,7 +188,7 @@ class DriveMotion(Motion):
         yaw: float,
         *,
         reverse: bool = False,
-        speed: float = rm.MAX_LINEAR_SPEED,
+        speed: float | None = None,
         stop_when=None,
         name: str = "drive",
         relative: bool = False,
@@ -195,7 +198,7 @@ class DriveMotion(Motion):
         self.relative = relative  # the goal was measured from where the base stood: hold the map frame
         self.goal = (x, y, yaw)
         self.reverse = reverse
-        self.speed = speed
+        self.speed = active_limits().linear_speed if speed is None else speed  # None: the base's limit
         self.stop_when = stop_when
         self.phase = "turning"
         self.start_distance = max(self._distance(), 1e-6)
@@ -231,7 +234,10 @@ class DriveMotion(Motion):
 
     def _turn_rate(self, error: float) -> float:
         return math.copysign(
-            _speed_for_distance(abs(error), rm.MAX_ANGULAR_ACCEL * 0.8, rm.MAX_ANGULAR_SPEED), error
+            _speed_for_distance(
+                abs(error), active_limits().angular_accel * 0.8, active_limits().angular_speed
+            ),
+            error,
         )
 
     def tick(self, dt: float) -> None:
@@ -262,7 +268,7 @@ class DriveMotion(Motion):
             direction = -1.0 if self.reverse else 1.0
             heading_error = self._heading_error()
             along = distance * math.cos(heading_error)
-            v = direction * _speed_for_distance(along, rm.MAX_LINEAR_ACCEL * 0.8, self.speed)
+            v = direction * _speed_for_distance(along, active_limits().linear_accel * 0.8, self.speed)
             if along < POSITION_TOLERANCE * 0.5 or distance < POSITION_TOLERANCE * 0.5:
                 v = 0.0
                 if base.stopped() or abs(base.v) < 0.02:
@@ -301,7 +307,7 @@ def docking_motion(
         wrap_angle(bearing - yaw),
         math.hypot(approach.x - x, approach.y - y),
         wrap_angle(approach.yaw - bearing),
-        rm.MAX_LINEAR_SPEED,
+        active_limits().linear_speed,
     )
     docking_s = drive_duration_s(0.0, math.hypot(dock.x - approach.x, dock.y - approach.y), 0.0, DOCK_SPEED)
 

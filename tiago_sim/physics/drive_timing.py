@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 
-from tiago_description import robot_model as rm
+from tiago_description.robot_limits import active_limits
 
 BLEND_ANGLE = 0.3  # rad: the drive starts once the heading is this close; the heading loop finishes the turn
 
@@ -58,8 +58,9 @@ def profile_s(
 
 def _turn_s(angle: float, start_speed: float, stop_short: float = 0.0) -> float:
     """A turn on the spot: speeding up at the angular limit, braking at 80 % of it."""
-    accel = rm.MAX_ANGULAR_ACCEL
-    return profile_s(angle, accel, accel * 0.8, rm.MAX_ANGULAR_SPEED, start_speed, stop_short)
+    limits = active_limits()
+    accel = limits.angular_accel
+    return profile_s(angle, accel, accel * 0.8, limits.angular_speed, start_speed, stop_short)
 
 
 SETTLE_S = 0.1
@@ -82,7 +83,11 @@ def drive_duration_s(
     moving = distance_m > 0.0
     turning = _turn_s(turn_rad, angular_speed if turn_rad else 0.0, BLEND_ANGLE if moving else 0.0)
     driving = profile_s(
-        distance_m, rm.MAX_LINEAR_ACCEL, rm.MAX_LINEAR_ACCEL * 0.8, speed, start_speed=linear_speed
+        distance_m,
+        active_limits().linear_accel,
+        active_limits().linear_accel * 0.8,
+        speed,
+        start_speed=linear_speed,
     )
     aligning = _turn_s(align_rad, 0.0 if moving or turn_rad else angular_speed)
     return turning + driving + aligning + SETTLE_S

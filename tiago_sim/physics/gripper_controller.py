@@ -22,6 +22,7 @@ import logging
 import pybullet as p
 
 from tiago_description import robot_model as rm
+from tiago_description.robot_limits import active_limits
 from tiago_sim.physics.grip_load import GripLoad, GripLoadMonitor
 from tiago_sim.physics.motion import CANCELED, Motion
 from tiago_sim.physics.robot_body import RobotBody
@@ -177,7 +178,7 @@ class GripperMotion(Motion):
         if not close:
             gripper.start_release()
         gripper.command(0.0 if close else rm.FINGER_TRAVEL)
-        self.remaining_s = rm.FINGER_TRAVEL / rm.FINGER_SPEED + 0.3
+        self.remaining_s = rm.FINGER_TRAVEL / active_limits().finger_speed + 0.3
 
     def tick(self, dt: float) -> None:
         gripper = self.gripper
@@ -194,7 +195,7 @@ class GripperMotion(Motion):
         target = 0.0 if self.close else rm.FINGER_TRAVEL
         remaining = abs(sum(gripper.body.joint_positions()[n] for n in gripper.fingers) / 2 - target)
         self.progress = float(min(0.99, 1.0 - remaining / rm.FINGER_TRAVEL))
-        self.remaining_s = remaining / rm.FINGER_SPEED + 0.2
+        self.remaining_s = remaining / active_limits().finger_speed + 0.2
         # stall from the fingers' travel over the last STALL_TIME_S (reported joint velocities jitter
         # while the gear constraint and the contacts balance)
         positions = [gripper.body.joint_positions()[n] for n in gripper.fingers]
@@ -206,7 +207,7 @@ class GripperMotion(Motion):
         moving = len(self.history) <= window or travel > STALL_SPEED * STALL_TIME_S
         self.stall_s = self.stall_s + dt if (started and not moving) else 0.0
         timed_out = (
-            self.elapsed_s > rm.FINGER_TRAVEL / rm.FINGER_SPEED + 1.0
+            self.elapsed_s > rm.FINGER_TRAVEL / active_limits().finger_speed + 1.0
         )  # fingers pressing but jittering
         if remaining < 5e-4 or self.stall_s > 0.0 or timed_out:
             if not self.close:

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 
-from tiago_description import robot_model as rm
+from tiago_description.robot_limits import active_limits
 from tiago_sim.navigation.planner import Plan
 from tiago_sim.physics.base_controller import DiffDriveBase, DriveMotion, wrap_angle
 from tiago_sim.physics.drive_timing import drive_duration_s
@@ -35,10 +35,12 @@ def path_motion(
     plan: Plan,
     goal_yaw: float,
     *,
-    speed: float = rm.MAX_LINEAR_SPEED,
+    speed: float | None = None,
     name: str = "drive",
 ) -> SequenceMotion:
-    """A motion driving the plan's segments in turn and ending at (last waypoint, goal_yaw)."""
+    """A motion driving the plan's segments in turn and ending at (last waypoint, goal_yaw); `speed`
+    None: the base's limit."""
+    speed = active_limits().linear_speed if speed is None else speed
     points = plan.waypoints
     segments = len(points) - 1
     reverse = [

@@ -25,6 +25,7 @@ import pybullet as p
 
 from tiago_description import robot_model
 from tiago_description import transforms as tf
+from tiago_description.robot_limits import active_limits
 
 BASE_CONSTRAINT_FORCE = 1e5
 ARM_POSITION_GAIN = 0.3
@@ -61,7 +62,9 @@ class RobotBody:
             self.link_index[info[12].decode()] = index
             if kind != p.JOINT_FIXED:
                 self.joint_index[name] = index
-                self.limits[name] = (info[8], info[9], info[11], info[10])
+                # the velocity the controllers hold it to: the lab's limit, within the URDF's (hardware)
+                velocity = active_limits().joint_velocity.get(name, info[11])
+                self.limits[name] = (info[8], info[9], velocity, info[10])
         # no default velocity motors fighting our controllers; hold every joint where it is
         for index in self.joint_index.values():
             p.setJointMotorControl2(self.id, index, p.VELOCITY_CONTROL, force=0.0, physicsClientId=client)

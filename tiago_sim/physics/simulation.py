@@ -297,7 +297,7 @@ class Simulation:
 
     # ----------------------------------------------------------------- motions
     def drive_to(
-        self, x: float, y: float, yaw: float, speed: float = rm.MAX_LINEAR_SPEED, relative: bool = False
+        self, x: float, y: float, yaw: float, speed: float | None = None, relative: bool = False
     ) -> Motion:
         """To a map pose; ``relative``: measured from where the base stands (DriveMotion)."""
         if self.is_docked():
@@ -308,7 +308,7 @@ class Simulation:
         self,
         plan: Plan,
         yaw: float,
-        speed: float = rm.MAX_LINEAR_SPEED,
+        speed: float | None = None,
         watch: UnmappedObstacles | None = None,
     ) -> Motion:
         """Drive a planned path (navigation.planner) segment by segment, ending facing ``yaw``;

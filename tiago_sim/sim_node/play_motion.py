@@ -33,7 +33,7 @@ from trajectory_msgs.msg import JointTrajectoryPoint
 from robot_port.tiago_interfaces import IS_MOTION_READY, LIST_MOTIONS, PLAY_MOTION2, controller_action
 from robot_port.types import JOINT_GROUPS
 from tiago_description import robot_model as rm
-from tiago_description.joint_limits import velocity_limits
+from tiago_description.robot_limits import active_limits
 from tiago_sim.sim_node.action_server import cancellable_server
 from tiago_sim.sim_node.named_motions import NamedMotion, TimedRows
 from tiago_sim.sim_node.sim_thread import SimThread
@@ -101,7 +101,7 @@ class PlayMotion2Server:
             return result
         self.played += 1
         current = self.sim_thread.run(lambda sim: sim.joint_positions(), ANSWER_TIMEOUT_S)
-        timed = motion.timed_from(current, velocity_limits())
+        timed = motion.timed_from(current, active_limits().joint_velocity)
         error = self._run(handle, controller_goals(timed, current))
         if not error:
             handle.succeed()
