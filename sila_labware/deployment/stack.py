@@ -31,6 +31,7 @@ from ros_bridge.domain import reserve_domain_id
 from ros_bridge.errors import BridgeError
 from ros_bridge.robot_link import RobotLink
 from ros_bridge.runtime import RosRuntime
+from ros_bridge.shared_memory import remove_dead_segments
 from ros_bridge.simulation_link import SimulationLink
 from sila_labware.deployment.lab_name import lab_name_of, robot_server_name, station_server_name
 from sila_labware.deployment.pacing import sim_pace_arguments
@@ -152,6 +153,8 @@ class Deployment:
 
     def start(self, should_stop: Callable[[], bool] = lambda: False) -> None:
         """Bring everything up; on any failure, stop what was started and re-raise."""
+        # what killed ROS processes of earlier runs left in /dev/shm goes first (it is never reused)
+        remove_dead_segments()
         try:
             self._start_robot_side()
             self._start_bridge(should_stop)
