@@ -65,8 +65,10 @@ approach sweeps in part (it drives at the bearing to the working pose, then turn
 where that approach may end: with the circle taken as 0.35 m and no margin, a working pose 0.361 m
 from its bench let the tray touch it (the base ended 12 mm nearer than its working pose)."""
 REACH_ARM = placement.REACH_ARM
-LOOK_TORSO_LIFT = 0.15
-"""The torso height of "Travel", where the first look at a station's marker is taken (m)."""
+LOOK_TORSO_LIFT = 0.32
+"""The torso height the marker is looked at with (m): the bench posture's ("Benchtop" in motions.yaml),
+which a drive to a station reaches as the base arrives at the POI (tiago_skills.drive_posture) and the
+final approach keeps. A test holds it to the motion library's value."""
 CAMERA_FOCAL_PX = 522.2
 MARKER_DISTANCE_RANGE = (0.4, 1.6)
 """Camera to marker centre (m): the camera clips at 0.3 m; beyond 1.5 to 2.5 m detection failed."""

@@ -28,8 +28,8 @@ from lab_description.world import Station
 from robot_port.execution import Execution
 from tiago_description import transforms as tf
 from tiago_description.kinematics import RobotKinematics, head_angles_towards, within_head_limits
-from tiago_skills.behaviours import move_joints
 from tiago_skills.goal_run import ActionAbort, GoalRun
+from tiago_skills.joint_commands import move_joints
 
 log = logging.getLogger(__name__)
 

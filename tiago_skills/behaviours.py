@@ -18,14 +18,14 @@ import numpy as np
 from labware_interfaces.msg import ErrorCodes
 
 from lab_description.serviceability import WORKING_CLEARANCE
-from robot_port.execution import Execution
-from robot_port.hardware import RobotHardware
 from robot_port.types import ARM_SIDES, JointTrajectory
 from tiago_description import robot_model as rm
 from tiago_description.motion_library import HOTEL_MOTIONS, MotionLibrary
 from tiago_description.transforms import make_transform
 from tiago_skills.arm_planning import ArmPlanning
+from tiago_skills.drive_posture import torso_for_drive
 from tiago_skills.goal_run import ActionAbort, GoalRun
+from tiago_skills.joint_commands import move_joints
 from tiago_skills.tool_path import tool_trajectory
 
 log = logging.getLogger(__name__)
@@ -69,11 +69,6 @@ def grasp_width_problem(opening_m: float, plate_widths: tuple[float, ...]) -> st
     )
 
 
-def move_joints(targets: dict[str, float], speed_scale: float = 1.0) -> Callable[[RobotHardware], Execution]:
-    """The command that moves joints to `targets` in one segment (for GoalRun.follow)."""
-    return lambda hardware: hardware.follow_joint_trajectory(JointTrajectory((dict(targets),), speed_scale))
-
-
 class RobotBehaviours:
     """Execute functions of the robot-level actions (one instance per robot)."""
 
@@ -88,6 +83,7 @@ class RobotBehaviours:
         speed_scale: Callable[[], float],
         seed: int | None = None,
         plate_widths: tuple[float, ...] = (),
+        station_pois: frozenset[str] = frozenset(),
     ) -> None:
         self.poi_pose = poi_pose
         self.poi_names = poi_names
@@ -96,6 +92,7 @@ class RobotBehaviours:
         self.motions = motions
         self.speed_scale = speed_scale
         self.plate_widths = plate_widths  # the short sides of the lab's plate types: what a grasp spans
+        self.station_pois = station_pois  # a drive to one of these ends with the torso at the bench height
         self.planning = ArmPlanning(seed)
         self.grasp_flipped: dict[str, bool] = {}  # per arm: twin of the top-down grasp last used
         self.holding: dict[str, bool] = {}  # per arm: the last gripper command closed on a plate
@@ -124,36 +121,27 @@ class RobotBehaviours:
             )
         if run.read(lambda hardware: hardware.is_docked()):
             raise ActionAbort(ErrorCodes.DOCKED, "the robot is docked: undock first")
-        lowering = self._lower_torso(run)
+        posture = torso_for_drive(run, self.motions, self.speed_scale(), goal.poi in self.station_pois)
         try:
-            # The drive has the whole progress: the torso lowers beside it and is nearly always down
-            # before the base arrives. With a share kept for the lowering, the drive's last report
-            # said 95 % done and 0 s left while nothing was left to do (a client saw it under load:
-            # test_remaining_time_is_never_zero_while_the_robot_still_moves[prepare] in CI); a
-            # torso still lowering after the drive reports its own remaining time at 100 %.
+            # The drive has the whole progress: the torso moves beside it and nearly always stands
+            # before the base arrives. With a share kept for the torso, the drive's last report said
+            # 95 % done and 0 s left while nothing was left to do (a client saw it under load:
+            # test_remaining_time_is_never_zero_while_the_robot_still_moves[prepare] in CI); a torso
+            # still moving after the drive reports its own remaining time at 100 %.
             name = f"POI {goal.poi!r}"
-            run.follow(lambda hardware: hardware.navigate_to(pose, name), span=(0.0, 1.0))
-            if lowering is not None:
-                run.follow(lowering, span=(1.0, 1.0))
+            run.follow(
+                lambda hardware: hardware.navigate_to(pose, name),
+                span=(0.0, 1.0),
+                while_running=None if posture is None else posture.poll,
+            )
+            if posture is not None:
+                posture.finish()
         except BaseException:
-            run.stop([lowering])  # a cancelled drive stops the torso too
+            run.stop(
+                [None if posture is None else posture.execution]
+            )  # a cancelled drive stops the torso too
             raise
         return {}
-
-    def _lower_torso(self, run: GoalRun) -> Any:
-        """Start the torso down to the travel height of "Travel" (it runs while the base drives)."""
-        travel = [
-            frame["torso_lift_joint"]
-            for frame in self.motions.keyframes.get("Travel", [])
-            if "torso_lift_joint" in frame
-        ]
-        if not travel:
-            return None
-        height = run.read(lambda hardware: hardware.joint_positions()["torso_lift_joint"])
-        if height <= travel[-1] + 0.01:
-            return None
-        speed = self.speed_scale() * self.motions.speed_scale
-        return run.read(move_joints({"torso_lift_joint": travel[-1]}, speed))
 
     def dock(self, run: GoalRun, _goal: Any) -> dict:
         if run.read(lambda hardware: hardware.is_docked()):

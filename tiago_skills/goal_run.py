@@ -116,6 +116,7 @@ class GoalRun:
         span: tuple[float, float] = (0.0, 1.0),
         later_s: float = 0.0,
         timeout_s: float = 600.0,
+        while_running: Callable[[Execution], None] | None = None,
     ) -> Execution:
         """Start a command on the hardware (or take one already started) and follow it until done.
 
@@ -123,6 +124,7 @@ class GoalRun:
         of the steps after this one (added to the remaining time). A cancel request cancels the
         command, waits until it has stopped and raises CANCELED; after `timeout_s` of robot time it
         is cancelled and fails (MOTION_FAILED). A failed command raises its own code and message.
+        `while_running` is called with the command at every poll (to start something beside it).
         """
         self.check_cancel()
         execution = start if isinstance(start, Execution) else self.read(start)
@@ -138,6 +140,8 @@ class GoalRun:
             self.feedback(
                 low + (high - low) * fraction, str(execution.phase), float(execution.remaining_s) + later_s
             )
+            if while_running is not None:
+                while_running(execution)
             execution.wait(_POLL_S)
         if cancel_sent and not timed_out:
             raise ActionAbort(ErrorCodes.CANCELED, f"canceled during {execution.name}: stopped safely")

@@ -42,10 +42,10 @@ from tiago_skills.behaviours import (
     TOOL_SPEED_FREE,
     TOOL_SPEED_INTO_POCKET,
     RobotBehaviours,
-    move_joints,
 )
 from tiago_skills.bench_route import BenchRoute, held_plate_box, station_boxes
 from tiago_skills.goal_run import ActionAbort, GoalRun
+from tiago_skills.joint_commands import move_joints
 from tiago_skills.perception.aruco import detect_marker
 from tiago_skills.perception.nest_occupancy import NestView, view_nest
 from tiago_skills.perception.site_frames import nest_in_base

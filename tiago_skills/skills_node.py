@@ -61,6 +61,7 @@ class RobotSkills:
             speed_scale=lambda: float(node.get_parameter("speed_scale").value),
             seed=seed,
             plate_widths=tuple(sorted({t.width for t in world.labware_types.values()})),
+            station_pois=frozenset(station.poi for station in world.stations),
         )
         self.marker_motion = MarkerMotionBehaviour(world, self.behaviours, motions.hotel)
         self.actions = RobotActionServers(

@@ -28,9 +28,11 @@ def test_an_idle_clock_follows_the_wall_clock_through_a_burst_of_jobs():
         for _ in range(200):  # one after the other: each wakes the thread on its own
             thread.run(lambda sim: sim.sim_time)
         sim_after = thread.run(lambda sim: sim.sim_time)
-        wall_s = time.monotonic() - wall_paced
-        step_s = 1 / 60  # the longest physics step
-        assert sim_after - sim_paced <= wall_s + 2 * step_s, (sim_after - sim_paced, wall_s)
+        wall_s = time.monotonic() - wall_before
+        # An extra physics step per job would add 200 / 60 = 3.3 s. Measured from before the paced
+        # half second, not after it: on a loaded machine the idle clock may lag the wall clock by a
+        # few steps at that read and catch up during the burst (0.1 s in 0.02 s, beside a campaign).
+        assert sim_after - sim_before <= wall_s + 0.1, (sim_after - sim_before, wall_s)
     finally:
         thread.stop()
 
