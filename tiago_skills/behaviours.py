@@ -121,7 +121,7 @@ class RobotBehaviours:
             )
         if run.read(lambda hardware: hardware.is_docked()):
             raise ActionAbort(ErrorCodes.DOCKED, "the robot is docked: undock first")
-        posture = torso_for_drive(run, self.motions, self.speed_scale(), goal.poi in self.station_pois)
+        torso = torso_for_drive(run, self.motions, self.speed_scale(), goal.poi in self.station_pois)
         try:
             # The drive has the whole progress: the torso moves beside it and nearly always stands
             # before the base arrives. With a share kept for the torso, the drive's last report said
@@ -132,14 +132,12 @@ class RobotBehaviours:
             run.follow(
                 lambda hardware: hardware.navigate_to(pose, name),
                 span=(0.0, 1.0),
-                while_running=None if posture is None else posture.poll,
+                while_running=None if torso is None else torso.poll,
             )
-            if posture is not None:
-                posture.finish()
+            if torso is not None:
+                torso.finish()
         except BaseException:
-            run.stop(
-                [None if posture is None else posture.execution]
-            )  # a cancelled drive stops the torso too
+            run.stop([None if torso is None else torso.execution])  # a cancelled drive stops the torso
             raise
         return {}
 

@@ -1,32 +1,31 @@
-"""The torso while the base drives: down to the travel height, or up to the bench's as it reaches a station.
+"""The torso while the base drives: up to the bench height on the way to a station, down elsewhere.
 
 Why: the final approach at a station waited for the torso's 0.17 m rise to the bench posture (2.7 s
-at 0.07 m/s) while the base covered its 0.22 m in 1.3 s; the torso set the approach's pace (the
-time budget on the benchmarks page, the robot-time issue). A real TIAGo++ lifts its torso while its
-base drives (separate controllers), so a drive to a station's POI now brings the torso to the bench
-height as the base arrives: the rise starts when the drive's own remaining time falls to the rise's
-duration, and a torso already there (a drive from one station to the next) stays. A drive anywhere
-else lowers it to the travel height at once, as before. Lives on: an rclpy executor thread (inside
-a navigation goal).
+at 0.07 m/s) while the base covered its 0.22 m in 1.3 s; the torso set the approach's pace (the time
+budget on the benchmarks page, the robot-time issue). A TIAGo++ lifts its torso while its base
+drives (separate controllers), so a drive to a station's POI takes the torso to the bench height
+beside the drive, and a drive from one station to the next keeps it there. Driving with it up
+changes neither the base's footprint nor the tucked arms' sweep across the floor; the arms only
+pass higher (from 0.91 m instead of 0.74 m up, over a standing bench's top too).
+
+Why beside the drive and not timed to end with it: the drive's remaining time is read once per
+poll of the goal, and an unpaced simulation covers up to 2 s of robot time between two polls, so a
+rise timed to the drive's end started late and kept the goal 0.3 to 0.8 s longer than the drive.
+It starts once the drive moves, not before: while navigation plans, a moving torso keeps an
+unpaced simulation's clock running, which counted the planning's wall time as 0.4 s of robot time.
+A drive anywhere else (the dock, a free POI) lowers the torso to the travel height, as before.
+Lives on: an rclpy executor thread (inside a navigation goal).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from robot_port.execution import Execution
-from robot_port.trajectory_timing import RAMP_S, trapezoid_duration
 from tiago_description.motion_library import MotionLibrary
-from tiago_description.robot_limits import active_limits
 from tiago_skills.goal_run import GoalRun
 from tiago_skills.joint_commands import move_joints
 
 TORSO = "torso_lift_joint"
 AT_HEIGHT_M = 0.01  # a torso this near its target is left where it stands
-LEAD_MARGIN_S = 0.5
-"""The rise starts this much earlier than its own duration before the drive's end: the drive's remaining
-time is read once per poll and runs a little short near the goal, and a torso still rising after the
-base stood kept the goal 0.4 s longer (seed 1, default lab); standing a moment early costs nothing."""
 
 
 def bench_torso_m(motions: MotionLibrary) -> float | None:
@@ -40,28 +39,24 @@ def travel_torso_m(motions: MotionLibrary) -> float | None:
     return heights[-1] if heights else None
 
 
-@dataclass
-class TorsoDuringDrive:
-    """The torso's move beside one drive: started at once, or when the drive's remaining time falls to
-    `lead_s` (None: not at all)."""
+class TorsoBesideDrive:
+    """The torso's move to `target_m` beside one drive, started once the drive moves (`poll`)."""
 
-    run: GoalRun
-    target_m: float
-    speed_scale: float
-    lead_s: float | None
-    execution: Execution | None = None
+    def __init__(self, run: GoalRun, target_m: float, speed_scale: float) -> None:
+        self.run, self.target_m, self.speed_scale = run, target_m, speed_scale
+        self.execution: Execution | None = None
+
+    def poll(self, drive: Execution) -> None:
+        """Called while the drive runs: start the torso once the drive has a plan and moves."""
+        if self.execution is None and float(drive.remaining_s) > 0.0:
+            self.start()
 
     def start(self) -> None:
         if self.execution is None:
             self.execution = self.run.read(move_joints({TORSO: self.target_m}, self.speed_scale))
 
-    def poll(self, drive: Execution) -> None:
-        """Called while the drive runs: start the rise once it would end as the base arrives."""
-        if self.lead_s is not None and float(drive.remaining_s) <= self.lead_s:
-            self.start()
-
     def finish(self) -> None:
-        """After the drive: a rise not yet started starts now; follow the move to its end."""
+        """After the drive: follow the torso to its end (started now if the drive never moved)."""
         self.start()
         assert self.execution is not None
         self.run.follow(self.execution, span=(1.0, 1.0))
@@ -69,19 +64,13 @@ class TorsoDuringDrive:
 
 def torso_for_drive(
     run: GoalRun, motions: MotionLibrary, speed_scale: float, to_station: bool
-) -> TorsoDuringDrive | None:
-    """What the torso does during a drive to a station's POI (`to_station`) or elsewhere; None: nothing."""
+) -> TorsoBesideDrive | None:
+    """The torso's move beside a drive to a station's POI (`to_station`) or elsewhere; None: it stays
+    (already there, or a low torso on the way elsewhere)."""
     target = bench_torso_m(motions) if to_station else travel_torso_m(motions)
     if target is None:
         return None
     height = run.read(lambda hardware: hardware.joint_positions()[TORSO])
     if abs(height - target) <= AT_HEIGHT_M or (not to_station and height < target):
-        return None  # there already; a low torso is not raised for travel
-    scale = speed_scale * motions.speed_scale
-    posture = TorsoDuringDrive(run, target, scale, None)
-    if to_station and height < target:  # rise as the base arrives
-        rise_s = trapezoid_duration((target - height) / (active_limits().torso_speed * scale), RAMP_S)
-        posture.lead_s = rise_s + LEAD_MARGIN_S
-    else:
-        posture.start()
-    return posture
+        return None
+    return TorsoBesideDrive(run, target, speed_scale * motions.speed_scale)
