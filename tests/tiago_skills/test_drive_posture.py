@@ -13,7 +13,6 @@ from types import SimpleNamespace
 import pytest
 from labware_interfaces.action import NavigateToPoi
 
-from lab_description.serviceability import LOOK_TORSO_LIFT
 from lab_description.world import DEFAULT_WORLD, load_world
 from tests.helpers.ros_processes import RosCaller
 from tiago_description.motion_library import load_motions
@@ -88,12 +87,11 @@ def test_a_drive_to_a_station_raises_the_torso_beside_it_and_ends_with_it_at_the
     assert risen_at < end_s - 0.5, (risen_at - started, end_s - started)
 
 
-def test_a_drive_elsewhere_lowers_the_torso_to_the_travel_height_and_the_loader_looks_from_the_bench_height(
+def test_a_drive_elsewhere_lowers_the_torso_to_the_travel_height(
     robot: tuple[SimulatedHardware, RobotBehaviours],
 ) -> None:
     hardware, behaviours = robot
     motions = load_motions()
-    assert LOOK_TORSO_LIFT == bench_torso_m(motions)  # the loader checks the view the robot has
     assert _navigate(hardware, behaviours, "station_b_work")[-1][1] == pytest.approx(
         bench_torso_m(motions), abs=0.005
     )
