@@ -45,6 +45,9 @@ from sila_labware.benchmarks.campaign import (
 
 logger = logging.getLogger(__name__)
 
+STOP_DEADLINE_S = 60
+"""A worker whose deployment takes longer than this to stop is ended by the kernel and its trial runs
+again (campaign.run_trial); a deployment stops in seconds (2 s per process at most before SIGKILL)."""
 _worker_index = 0  # in a worker process: its index, which sets its ports and ROS domain
 _started_dir = ""  # in a worker process: where it notes each trial it starts (a file per seed)
 
@@ -69,7 +72,8 @@ def _start_worker(indices: multiprocessing.Queue, levels: dict[str, int], starte
 
 
 def _run_in_worker(options: CampaignOptions, trial_seed: int, record: bool) -> TrialOutcome:
-    return run_trial(options, trial_seed, options.record_dir if record else None, worker=_worker_index)
+    record_dir = options.record_dir if record else None
+    return run_trial(options, trial_seed, record_dir, worker=_worker_index, stop_deadline_s=STOP_DEADLINE_S)
 
 
 def _noted(trial: Callable[..., TrialOutcome], options: CampaignOptions, seed: int, record: bool) -> Any:

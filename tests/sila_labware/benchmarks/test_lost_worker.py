@@ -13,7 +13,13 @@ import signal
 import time
 from pathlib import Path
 
-from sila_labware.benchmarks.campaign import CampaignOptions, TrialOutcome, format_table, summarize
+from sila_labware.benchmarks.campaign import (
+    CampaignOptions,
+    TrialOutcome,
+    format_table,
+    stop_within,
+    summarize,
+)
 from sila_labware.benchmarks.levels import default_level_values
 from sila_labware.benchmarks.workers import run_parallel_campaign
 from sila_labware.deployment.stack import DeploymentOptions
@@ -72,3 +78,22 @@ def test_a_trial_lost_once_runs_again_and_the_report_says_so(tmp_path: Path) -> 
     assert summary["successes"] == TRIALS
     assert CRASHING_SEED in {trial["seed"] for trial in summary["rerun_trials"]}
     assert "run again after their worker process died" in format_table(summary)
+
+
+def hang_once_at_stop(options: CampaignOptions, seed: int, _record: bool) -> TrialOutcome:
+    """As `crash_once`, but the first run hangs while it stops its deployment (as Fast DDS once spun
+    for minutes destroying a participant): the campaign's stop deadline must end the worker."""
+    marker = options.stack.world.with_name(f"hung_{seed}")
+    if seed == CRASHING_SEED and not marker.exists():
+        marker.touch()
+        stop_within(lambda: time.sleep(60.0), deadline_s=1)
+    return TrialOutcome(seed, True, "", "", 1.0, 0.2, 0.0, 1.0)
+
+
+def test_a_trial_that_hangs_while_it_stops_is_ended_by_the_deadline_and_runs_again(tmp_path: Path) -> None:
+    options = campaign(tmp_path)
+    outcomes = run_parallel_campaign(options, progress_stream=None, trial=hang_once_at_stop)
+    assert [outcome.seed for outcome in outcomes] == list(range(SEED, SEED + TRIALS))
+    assert all(outcome.success for outcome in outcomes)
+    hung = next(outcome for outcome in outcomes if outcome.seed == CRASHING_SEED)
+    assert len(hung.lost_runs) == 1  # its worker was ended: a stop that had run its 60 s would not be
