@@ -1,0 +1,140 @@
+"""What Ray adds to a campaign, and what one trial needs: the same campaign on workers and on Ray.
+
+    python -m sila_labware.benchmarks.cluster_overhead --trials 20 --seed S [--jobs 2] [--json]
+
+Runs `bench --trials N --seed S --jobs J` and then `bench --trials N --seed S --cluster local` (a
+one-node Ray cluster on the same cores) and prints, for each, the CPU seconds of its whole process
+tree per trial, the wall time, and the peak memory of the tree; then Ray's overhead per trial (CPU
+seconds and as a ratio) and one trial's memory (the workers' peak over J trials at once).
+
+Why CPU seconds: wall time follows the machine's load (a campaign beside another), CPU much less.
+The CPU is that of every process the campaign started, Ray's included (`interleaved_cpu.measure`:
+this process is a child subreaper, so the daemons and workers Ray leaves behind are adopted and
+counted when they end). Memory is the proportional set size (PSS: pages shared between processes,
+such as a prewarmed robot side's, counted once in all) of the tree, sampled every half second.
+Threads: the main thread runs the campaigns; one thread samples memory.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import threading
+from pathlib import Path
+from typing import Any
+
+from sila_labware.benchmarks.interleaved_cpu import become_subreaper, measure
+
+SAMPLE_PERIOD_S = 0.5
+
+
+class TreeMemory:
+    """The peak PSS of every process below this one, sampled on a thread of its own."""
+
+    def __init__(self) -> None:
+        self.peak_bytes = 0
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._sample, name="tree-memory", daemon=True)
+
+    def __enter__(self) -> TreeMemory:
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self._stop.set()
+        self._thread.join()
+
+    def _sample(self) -> None:
+        while not self._stop.wait(SAMPLE_PERIOD_S):
+            self.peak_bytes = max(self.peak_bytes, sum(map(_pss_bytes, descendants(os.getpid()))))
+
+
+def descendants(root: int) -> set[int]:
+    """Every process below `root` (read from /proc: the robot side runs in sessions of its own)."""
+    parents: dict[int, int] = {}
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            parents[int(stat.parent.name)] = int(stat.read_text().rsplit(")", 1)[1].split()[1])
+        except (OSError, IndexError, ValueError):
+            continue
+    found, frontier = set(), {root}
+    while frontier:
+        frontier = {pid for pid, parent in parents.items() if parent in frontier} - found
+        found |= frontier
+    return found
+
+
+def _pss_bytes(pid: int) -> int:
+    try:
+        for line in Path(f"/proc/{pid}/smaps_rollup").read_text().splitlines():
+            if line.startswith("Pss:"):
+                return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    return 0
+
+
+def run_one(flags: list[str], trials: int, seed: int) -> dict[str, Any]:
+    """One campaign as `bench` runs it: CPU s, wall s, peak memory and what it delivered."""
+    command = [
+        sys.executable,
+        "-m",
+        "sila_labware.cli",
+        "bench",
+        "--trials",
+        str(trials),
+        "--seed",
+        str(seed),
+    ]
+    with TreeMemory() as memory:
+        done, cpu_s, wall_s = measure([*command, *flags, "--json"], Path.cwd(), dict(os.environ))
+    summary = json.loads(done.stdout) if done.stdout.strip() else {}
+    return {
+        "command": " ".join(["sila-labware", *command[3:], *flags]),  # as a user would type it
+        "trials": summary.get("trials", 0),
+        "delivered": summary.get("successes", 0),
+        "cpu_seconds": cpu_s,
+        "cpu_seconds_per_trial": cpu_s / trials,
+        "wall_seconds": wall_s,
+        "peak_memory_mb": memory.peak_bytes / 2**20,
+    }
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--trials", type=int, default=20)
+    parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--jobs", type=int, default=2, help="workers, and the local cluster's CPUs")
+    parser.add_argument("--json", action="store_true")
+    args = parser.parse_args(argv)
+    become_subreaper()
+    workers = run_one(["--jobs", str(args.jobs)], args.trials, args.seed)
+    cluster = run_one(["--cluster", "local"], args.trials, args.seed)
+    overhead = cluster["cpu_seconds_per_trial"] - workers["cpu_seconds_per_trial"]
+    figures = {
+        "workers": workers,
+        "cluster": cluster,
+        "ray_cpu_seconds_per_trial": overhead,
+        "ray_cpu_ratio": cluster["cpu_seconds_per_trial"] / workers["cpu_seconds_per_trial"],
+        "memory_per_trial_mb": workers["peak_memory_mb"] / args.jobs,
+    }
+    if args.json:
+        sys.stdout.write(json.dumps(figures, indent=1) + "\n")
+    else:
+        for run in (workers, cluster):
+            sys.stdout.write(
+                f"{run['command']}: {run['delivered']}/{run['trials']} delivered, "
+                f"{run['cpu_seconds_per_trial']:.1f} CPU s per trial, {run['wall_seconds']:.0f} s wall, "
+                f"peak {run['peak_memory_mb']:.0f} MB\n"
+            )
+        sys.stdout.write(
+            f"Ray's overhead: {overhead:+.2f} CPU s per trial (x{figures['ray_cpu_ratio']:.3f}); "
+            f"memory per trial: {figures['memory_per_trial_mb']:.0f} MB\n"
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
