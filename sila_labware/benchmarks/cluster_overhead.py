@@ -1,11 +1,14 @@
 """What Ray adds to a campaign, and what one trial needs: the same campaign on workers and on Ray.
 
-    python -m sila_labware.benchmarks.cluster_overhead --trials 20 --seed S [--jobs 2] [--json]
+    python -m sila_labware.benchmarks.cluster_overhead --trials 20 --seed S [--jobs 2] [--two-nodes]
+                                                      [--json]
 
 Runs `bench --trials N --seed S --jobs J` and then `bench --trials N --seed S --cluster local` (a
-one-node Ray cluster on the same cores) and prints, for each, the CPU seconds of its whole process
-tree per trial, the wall time, and the peak memory of the tree; then Ray's overhead per trial (CPU
-seconds and as a ratio) and one trial's memory (the workers' peak over J trials at once).
+one-node Ray cluster on the same cores), or with `--two-nodes` `bench ... --cluster ADDRESS` on a
+cluster of J nodes of one CPU each (a raylet each) that this process starts on this machine and
+stops after the campaign, its start and stop counted in. Prints, for each, the CPU seconds of its
+whole process tree per trial, the wall time and the tree's peak memory; then Ray's overhead per
+trial (CPU seconds and as a ratio) and one trial's memory (the workers' peak over J trials at once).
 
 Why CPU seconds: wall time follows the machine's load (a campaign beside another), CPU much less.
 The CPU is that of every process the campaign started, Ray's included (`interleaved_cpu.measure`:
@@ -20,12 +23,14 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import shutil
 import sys
+import tempfile
 import threading
 from pathlib import Path
 from typing import Any
 
-from sila_labware.benchmarks.interleaved_cpu import become_subreaper, measure
+from sila_labware.benchmarks.interleaved_cpu import become_subreaper, children_cpu_s, measure, reap_orphans
 
 SAMPLE_PERIOD_S = 0.5
 
@@ -76,6 +81,30 @@ def _pss_bytes(pid: int) -> int:
     return 0
 
 
+def run_on_nodes(nodes: int, trials: int, seed: int) -> dict[str, Any]:
+    """The campaign on a cluster of `nodes` one-CPU nodes started here: the CPU of every Ray process
+    from the cluster's start to its stop, and of the campaign."""
+    from ray.cluster_utils import Cluster
+
+    temp_dir = tempfile.mkdtemp(prefix="ray-")  # Ray's socket paths must stay short
+    os.environ["RAY_TMPDIR"] = temp_dir  # its note of the "current cluster" too: no other `auto` finds it
+    Path(temp_dir, "ray").mkdir()
+    cpu_before = children_cpu_s()
+    cluster = Cluster()
+    try:
+        for index in range(nodes):
+            cluster.add_node(num_cpus=1, **({"include_dashboard": False} if index == 0 else {}))
+        cluster.wait_for_nodes()
+        run = run_one(["--cluster", cluster.address], trials, seed)
+    finally:
+        cluster.shutdown()
+        reap_orphans()
+        shutil.rmtree(temp_dir, ignore_errors=True)
+    cpu_s = children_cpu_s() - cpu_before
+    run["command"] = run["command"].replace(cluster.address or "", f"ADDRESS ({nodes} nodes)")
+    return {**run, "cpu_seconds": cpu_s, "cpu_seconds_per_trial": cpu_s / trials}
+
+
 def run_one(flags: list[str], trials: int, seed: int) -> dict[str, Any]:
     """One campaign as `bench` runs it: CPU s, wall s, peak memory and what it delivered."""
     command = [
@@ -107,11 +136,15 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--trials", type=int, default=20)
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--jobs", type=int, default=2, help="workers, and the local cluster's CPUs")
+    parser.add_argument("--two-nodes", action="store_true", help="a cluster of --jobs nodes, not one")
     parser.add_argument("--json", action="store_true")
     args = parser.parse_args(argv)
     become_subreaper()
     workers = run_one(["--jobs", str(args.jobs)], args.trials, args.seed)
-    cluster = run_one(["--cluster", "local"], args.trials, args.seed)
+    if args.two_nodes:
+        cluster = run_on_nodes(args.jobs, args.trials, args.seed)
+    else:
+        cluster = run_one(["--cluster", "local"], args.trials, args.seed)
     overhead = cluster["cpu_seconds_per_trial"] - workers["cpu_seconds_per_trial"]
     figures = {
         "workers": workers,

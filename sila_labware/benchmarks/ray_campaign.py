@@ -57,7 +57,8 @@ LOCAL_OBJECT_STORE_BYTES = 100 * 1024 * 1024
 
 
 class ClusterError(RuntimeError):
-    """The cluster cannot run the campaign: unreachable, no nodes, or it keeps losing them."""
+    """The cluster cannot run the campaign: unreachable, no nodes, nodes that cannot import or run a
+    trial, or that keep getting lost."""
 
 
 def check_reachable(address: str) -> None:
@@ -177,8 +178,11 @@ class _ClusterCampaign:
 
         try:
             result: NodeResult = ray.get(ref)
-        except RayTaskError as error:  # run_trial raised: a bug on the trial's side, not the cluster
-            raise RuntimeError(f"trial seed {seed} raised on its node: {error}") from error
+        except RayTaskError as error:  # run_trial never raises for a failed trial: the node cannot run it
+            raise ClusterError(
+                f"trial seed {seed} could not run on its node (the same installation of sila-labware "
+                f"on every node?): {_first_line(error.cause or error)}"
+            ) from error
         except NodeDiedError as error:
             self._node_lost(seed, error)
             return
