@@ -24,9 +24,11 @@ import argparse
 import json
 import os
 import shutil
+import subprocess
 import sys
 import tempfile
 import threading
+import time
 from pathlib import Path
 from typing import Any
 
@@ -81,47 +83,66 @@ def _pss_bytes(pid: int) -> int:
     return 0
 
 
+CLUSTER_SCRIPT = """
+import sys
+from ray.cluster_utils import Cluster
+cluster = Cluster()
+for index in range(int(sys.argv[1])):
+    cluster.add_node(num_cpus=1, **({"include_dashboard": False} if index == 0 else {}))
+cluster.wait_for_nodes()
+print(cluster.address, flush=True)
+sys.stdin.read()  # until the benchmark closes it
+cluster.shutdown()
+"""
+"""A cluster of one-CPU nodes in a process of its own, whose CPU (its daemons' and their workers')
+reaches this process's RUSAGE_CHILDREN when it ends."""
+
+
 def run_on_nodes(nodes: int, trials: int, seed: int) -> dict[str, Any]:
     """The campaign on a cluster of `nodes` one-CPU nodes started here: the CPU of every Ray process
     from the cluster's start to its stop, and of the campaign."""
-    from ray.cluster_utils import Cluster
-
     temp_dir = tempfile.mkdtemp(prefix="ray-")  # Ray's socket paths must stay short
-    os.environ["RAY_TMPDIR"] = temp_dir  # its note of the "current cluster" too: no other `auto` finds it
     Path(temp_dir, "ray").mkdir()
+    environment = {**os.environ, "RAY_TMPDIR": temp_dir}  # no other `auto` finds this cluster
     cpu_before = children_cpu_s()
-    cluster = Cluster()
-    try:
-        for index in range(nodes):
-            cluster.add_node(num_cpus=1, **({"include_dashboard": False} if index == 0 else {}))
-        cluster.wait_for_nodes()
-        run = run_one(["--cluster", cluster.address], trials, seed)
-    finally:
-        cluster.shutdown()
-        reap_orphans()
-        shutil.rmtree(temp_dir, ignore_errors=True)
-    cpu_s = children_cpu_s() - cpu_before
-    run["command"] = run["command"].replace(cluster.address or "", f"ADDRESS ({nodes} nodes)")
-    return {**run, "cpu_seconds": cpu_s, "cpu_seconds_per_trial": cpu_s / trials}
+    with subprocess.Popen(
+        [sys.executable, "-c", CLUSTER_SCRIPT, str(nodes)],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        text=True,
+        env=environment,
+    ) as cluster:
+        assert cluster.stdin is not None and cluster.stdout is not None
+        address = cluster.stdout.readline().strip()
+        command = [sys.executable, "-m", "sila_labware.cli", "bench", "--trials", str(trials)]
+        command += ["--seed", str(seed), "--cluster", address, "--json"]
+        started = time.monotonic()
+        with TreeMemory() as memory:
+            done = subprocess.run(command, capture_output=True, text=True, env=environment, check=False)
+        wall_s = time.monotonic() - started
+        cluster.stdin.close()
+    reap_orphans()
+    shutil.rmtree(temp_dir, ignore_errors=True)
+    text = f"sila-labware bench --trials {trials} --seed {seed} --cluster ADDRESS ({nodes} nodes)"
+    return _figures(text, done.stdout, trials, children_cpu_s() - cpu_before, wall_s, memory)
 
 
 def run_one(flags: list[str], trials: int, seed: int) -> dict[str, Any]:
     """One campaign as `bench` runs it: CPU s, wall s, peak memory and what it delivered."""
-    command = [
-        sys.executable,
-        "-m",
-        "sila_labware.cli",
-        "bench",
-        "--trials",
-        str(trials),
-        "--seed",
-        str(seed),
-    ]
+    command = [sys.executable, "-m", "sila_labware.cli", "bench", "--trials", str(trials)]
+    command += ["--seed", str(seed)]
     with TreeMemory() as memory:
         done, cpu_s, wall_s = measure([*command, *flags, "--json"], Path.cwd(), dict(os.environ))
-    summary = json.loads(done.stdout) if done.stdout.strip() else {}
+    text = " ".join(["sila-labware", *command[3:], *flags])  # as a user would type it
+    return _figures(text, done.stdout, trials, cpu_s, wall_s, memory)
+
+
+def _figures(
+    command: str, stdout: str, trials: int, cpu_s: float, wall_s: float, memory: TreeMemory
+) -> dict[str, Any]:
+    summary = json.loads(stdout) if stdout.strip() else {}
     return {
-        "command": " ".join(["sila-labware", *command[3:], *flags]),  # as a user would type it
+        "command": command,
         "trials": summary.get("trials", 0),
         "delivered": summary.get("successes", 0),
         "cpu_seconds": cpu_s,
