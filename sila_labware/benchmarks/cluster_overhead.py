@@ -6,16 +6,19 @@
 Runs `bench --trials N --seed S --jobs J` and then `bench --trials N --seed S --cluster local` (a
 one-node Ray cluster on the same cores), or with `--two-nodes` `bench ... --cluster ADDRESS` on a
 cluster of J nodes of one CPU each (a raylet each) that this process starts on this machine and
-stops after the campaign, its start and stop counted in. Prints, for each, the CPU seconds of its
-whole process tree per trial, the wall time and the tree's peak memory; then Ray's overhead per
-trial (CPU seconds and as a ratio) and one trial's memory (the workers' peak over J trials at once).
+stops after the campaign. Prints, for each, the CPU seconds of its whole process tree per trial, the
+wall time and the tree's peak memory; then Ray's overhead per trial (CPU seconds and as a ratio)
+and one trial's memory (the workers' peak over J trials at once).
 
 Why CPU seconds: wall time follows the machine's load (a campaign beside another), CPU much less.
-The CPU is that of every process the campaign started, Ray's included (`interleaved_cpu.measure`:
-this process is a child subreaper, so the daemons and workers Ray leaves behind are adopted and
-counted when they end). Memory is the proportional set size (PSS: pages shared between processes,
-such as a prewarmed robot side's, counted once in all) of the tree, sampled every half second.
-Threads: the main thread runs the campaigns; one thread samples memory.
+The CPU is that of every process the campaign started, Ray's included, counted two ways:
+`getrusage(RUSAGE_CHILDREN)` (`interleaved_cpu.measure`: this process is a child subreaper, so what
+Ray's processes leave behind is adopted and counted when it ends), and the CPU of each process as
+last seen in /proc every quarter second. The first is complete unless a process reaps a child
+without passing its CPU on, as a raylet that is not this process's child does with its workers
+(`--two-nodes`): there the samples count. Memory is the proportional set size (PSS: pages shared
+between processes, such as a prewarmed robot side's, counted once in all) of the tree, sampled too.
+Threads: the main thread runs the campaigns; one thread samples /proc.
 """
 
 from __future__ import annotations
@@ -34,14 +37,17 @@ from typing import Any
 
 from sila_labware.benchmarks.interleaved_cpu import become_subreaper, children_cpu_s, measure, reap_orphans
 
-SAMPLE_PERIOD_S = 0.5
+SAMPLE_PERIOD_S = 0.25
 
 
 class TreeMemory:
-    """The peak PSS of every process below this one, sampled on a thread of its own."""
+    """The peak PSS of every process below this one, and the CPU each used as last seen (no process
+    reaps another's CPU away from this count, unlike RUSAGE_CHILDREN: see CLUSTER_SCRIPT), sampled on
+    a thread of its own. A process's CPU after its last sample is missed (a sample period at most)."""
 
     def __init__(self) -> None:
         self.peak_bytes = 0
+        self._cpu_ticks: dict[tuple[int, int], int] = {}  # (pid, start time) -> utime + stime
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._sample, name="tree-memory", daemon=True)
 
@@ -53,9 +59,20 @@ class TreeMemory:
         self._stop.set()
         self._thread.join()
 
+    @property
+    def sampled_cpu_s(self) -> float:
+        return sum(self._cpu_ticks.values()) / os.sysconf("SC_CLK_TCK")
+
     def _sample(self) -> None:
         while not self._stop.wait(SAMPLE_PERIOD_S):
-            self.peak_bytes = max(self.peak_bytes, sum(map(_pss_bytes, descendants(os.getpid()))))
+            pids = descendants(os.getpid())
+            self.peak_bytes = max(self.peak_bytes, sum(map(_pss_bytes, pids)))
+            for pid in pids:
+                try:
+                    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+                    self._cpu_ticks[(pid, int(fields[19]))] = int(fields[11]) + int(fields[12])
+                except (OSError, IndexError, ValueError):
+                    continue
 
 
 def descendants(root: int) -> set[int]:
@@ -120,7 +137,7 @@ def run_on_nodes(nodes: int, trials: int, seed: int) -> dict[str, Any]:
         command = [sys.executable, "-m", "sila_labware.cli", "bench", "--trials", str(trials)]
         command += ["--seed", str(seed), "--cluster", address, "--json"]
         started = time.monotonic()
-        with TreeMemory() as memory:
+        with TreeMemory() as memory:  # this process is the root: the cluster's processes count too
             done = subprocess.run(command, capture_output=True, text=True, env=environment, check=False)
         wall_s = time.monotonic() - started
         cluster.stdin.close()
@@ -152,6 +169,7 @@ def _figures(
         "cpu_seconds_per_trial": cpu_s / trials,
         "wall_seconds": wall_s,
         "peak_memory_mb": memory.peak_bytes / 2**20,
+        "sampled_cpu_seconds_per_trial": memory.sampled_cpu_s / trials,
     }
 
 
@@ -169,12 +187,15 @@ def main(argv: list[str] | None = None) -> int:
         cluster = run_on_nodes(args.jobs, args.trials, args.seed)
     else:
         cluster = run_one(["--cluster", "local"], args.trials, args.seed)
-    overhead = cluster["cpu_seconds_per_trial"] - workers["cpu_seconds_per_trial"]
+    # rusage misses the workers of a cluster started apart (CLUSTER_SCRIPT): there, the samples
+    key = "sampled_cpu_seconds_per_trial" if args.two_nodes else "cpu_seconds_per_trial"
+    overhead = cluster[key] - workers[key]
     figures = {
         "workers": workers,
         "cluster": cluster,
+        "compared": key,
         "ray_cpu_seconds_per_trial": overhead,
-        "ray_cpu_ratio": cluster["cpu_seconds_per_trial"] / workers["cpu_seconds_per_trial"],
+        "ray_cpu_ratio": cluster[key] / workers[key],
         "memory_per_trial_mb": workers["peak_memory_mb"] / args.jobs,
     }
     if args.json:
@@ -183,7 +204,7 @@ def main(argv: list[str] | None = None) -> int:
         for run in (workers, cluster):
             sys.stdout.write(
                 f"{run['command']}: {run['delivered']}/{run['trials']} delivered, "
-                f"{run['cpu_seconds_per_trial']:.1f} CPU s per trial, {run['wall_seconds']:.0f} s wall, "
+                f"{run[key]:.2f} CPU s per trial, {run['wall_seconds']:.0f} s wall, "
                 f"peak {run['peak_memory_mb']:.0f} MB\n"
             )
         sys.stdout.write(
