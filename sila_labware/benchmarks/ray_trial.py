@@ -71,7 +71,7 @@ def run_trial_on_node(
         _prepared = True
     scratch = Path(tempfile.mkdtemp(prefix="sila-labware-trial-"))
     try:
-        local = _local_options(options, trial_seed, files, scratch)
+        local = options_on_node(options, trial_seed, files, scratch)
         frames_dir = scratch / "frames" if record else None
         outcome = run_trial(local, trial_seed, frames_dir)
         layouts = options.layouts_dir
@@ -82,7 +82,7 @@ def run_trial_on_node(
     return NodeResult(replace(outcome, world=str(world), node=_node_name()), frames)
 
 
-def _local_options(
+def options_on_node(
     options: CampaignOptions, trial_seed: int, files: TrialFiles, scratch: Path
 ) -> CampaignOptions:
     """The campaign's options with this node's world file, layout, CA file, ports and ROS domain."""

@@ -33,7 +33,7 @@ import pytest
 from sila_labware.benchmarks.campaign import PORTS_PER_WORKER
 from sila_labware.benchmarks.cluster_overhead import descendants
 from sila_labware.benchmarks.ray_campaign import SILA2_ENVIRONMENT
-from tests.helpers.sila_stack import free_port_base
+from tests.helpers.sila_stack import DEFAULT_WORLD, free_port_base
 from tests.sila_labware.benchmarks.test_bench import CLI, run_bench
 
 SEED = 4242
@@ -199,3 +199,49 @@ def test_a_cluster_that_cannot_be_reached_ends_the_campaign_with_a_clear_error(t
     # `auto` with no cluster started on this machine (Ray looks for one in its temp folder)
     done = bench_quickly("--cluster", "auto", environment={**os.environ, "RAY_TMPDIR": str(tmp_path)})
     assert done.returncode == 1 and "cannot connect to the Ray cluster at auto" in done.stderr
+
+
+def test_a_cluster_with_no_cpu_ends_the_campaign_with_a_clear_error(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A head that takes no tasks (`num-cpus 0`, as on Kubernetes) and no worker node."""
+    from ray.cluster_utils import Cluster
+
+    from sila_labware.benchmarks import ray_campaign
+    from sila_labware.benchmarks.campaign import CampaignOptions
+    from sila_labware.benchmarks.levels import default_level_values
+    from sila_labware.deployment.stack import DeploymentOptions
+
+    monkeypatch.setattr(ray_campaign, "NO_CPU_GRACE_S", 2.0)  # an autoscaler's minute, shortened
+    temp_dir = tempfile.mkdtemp(prefix="ray-", dir="/tmp")
+    monkeypatch.setenv("RAY_TMPDIR", temp_dir)
+    Path(temp_dir, "ray").mkdir()
+    cluster = Cluster()
+    try:
+        cluster.add_node(num_cpus=0, object_store_memory=NODE["object_store_memory"], include_dashboard=False)
+        options = CampaignOptions(DeploymentOptions(world=DEFAULT_WORLD), SEED, 1, default_level_values())
+        with pytest.raises(ray_campaign.ClusterError, match="no CPU for 2 s: no node can run a trial"):
+            ray_campaign.run_cluster_campaign(options, cluster.address, progress_stream=None)
+    finally:
+        cluster.shutdown()
+        shutil.rmtree(temp_dir, ignore_errors=True)
+
+
+def test_a_trial_on_a_node_gets_the_drivers_world_and_layout_as_files_of_its_own(tmp_path: Path) -> None:
+    """What a task carries to a node that has none of the driver's files, and what it does there."""
+    from sila_labware.benchmarks.campaign import CampaignOptions, layout_path
+    from sila_labware.benchmarks.levels import default_level_values
+    from sila_labware.benchmarks.ray_trial import TrialFiles, options_on_node
+    from sila_labware.deployment.stack import DeploymentOptions
+
+    driver, node = tmp_path / "driver", tmp_path / "node"
+    driver.mkdir(), node.mkdir()
+    layout_path(driver, SEED).write_text("name: random layout\n")
+    stack = DeploymentOptions(world=DEFAULT_WORLD, port_base=free_port_base(PORTS_PER_WORKER), domain_id=7)
+    options = CampaignOptions(stack, SEED, 1, default_level_values(), layouts_dir=driver, jobs=2)
+    files = TrialFiles.of(options, SEED)
+    local = options_on_node(options, SEED, files, node)
+    assert local.stack.world.read_text() == DEFAULT_WORLD.read_text() and local.stack.world.parent == node
+    assert layout_path(local.layouts_dir, SEED).read_text() == "name: random layout\n"
+    assert local.stack.ca_file.parent == node and local.stack.domain_id is None  # reserved on its host
+    assert local.stack.port_base >= stack.port_base and (local.jobs, local.record_dir) == (1, None)
