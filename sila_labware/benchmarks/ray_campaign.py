@@ -22,9 +22,11 @@ from __future__ import annotations
 import logging
 import os
 import shutil
+import signal
 import socket
 import sys
 import tempfile
+import threading
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager, redirect_stdout
@@ -51,6 +53,8 @@ NODE_LOSSES_ALLOWED = 3
 NO_CPU_GRACE_S = 60.0
 """How long a cluster may offer no CPU (nodes joining, an autoscaler adding some) before giving up."""
 CONNECT_TIMEOUT_S = 5.0
+CANCEL_GRACE_S = 5.0
+"""How long a cancelled trial has to stop its deployment before its Ray worker is killed."""
 SILA2_ENVIRONMENT = ("PROTOCOL_BUFFERS_PYTHON_IMPLEMENTATION", "GRPC_ENABLE_FORK_SUPPORT")
 LOCAL_OBJECT_STORE_BYTES = 100 * 1024 * 1024
 """A local cluster's object store: outcomes and one trial's frames, a few MB (Ray's floor is 75 MB)."""
@@ -90,6 +94,7 @@ def connected(address: str, local_cpus: int, verbose: bool = False) -> Iterator[
 def _connected(ray: Any, address: str, local_cpus: int, verbose: bool) -> Iterator[None]:
     quiet = {"include_dashboard": False, "log_to_driver": verbose, "logging_level": logging.WARNING}
     scratch = None
+    handlers = {number: signal.getsignal(number) for number in (signal.SIGINT, signal.SIGTERM)}
     try:
         if address == LOCAL:
             scratch = tempfile.mkdtemp(prefix="ray-")  # Ray's socket paths must stay short
@@ -100,6 +105,11 @@ def _connected(ray: Any, address: str, local_cpus: int, verbose: bool) -> Iterat
             ray.init(address=address, **quiet)
     except (ConnectionError, RuntimeError) as error:
         raise ClusterError(f"cannot connect to the Ray cluster at {address}: {error}") from error
+    # Ray's core worker installs its own SIGTERM handler, which aborts the process: the bench's own
+    # (stop the running trials, summarise the done ones, exit 130) come back.
+    for number, handler in handlers.items():
+        if handler is not None and threading.current_thread() is threading.main_thread():
+            signal.signal(number, handler)
     try:
         yield
     finally:
@@ -161,9 +171,7 @@ class _ClusterCampaign:
                 "interrupted: %d of %d trial(s) done; cancelling the running ones",
                 len(self._outcomes), self._options.trials,
             )  # fmt: skip
-            for ref in self._running:  # a KeyboardInterrupt in the task: it stops its deployment
-                ray.cancel(ref)
-            ray.wait(list(self._running), num_returns=len(self._running), timeout=30.0)
+            _cancel(list(self._running))
         return sorted(self._outcomes, key=lambda outcome: outcome.seed)
 
     def _submit(self, seed: int) -> None:
@@ -210,6 +218,21 @@ class _ClusterCampaign:
             return
         logger.warning("trial seed %d lost its worker process: it runs again", seed)
         self._submit(seed)
+
+
+def _cancel(refs: list[Any]) -> None:
+    """Stop running trials: a KeyboardInterrupt in each task first (its deployment stops on the way
+    out), then its worker killed if it is still running after CANCEL_GRACE_S (a library may turn the
+    interrupt into an error of its own and the trial run on); a robot side whose starter is gone stops
+    by itself."""
+    import ray
+
+    for ref in refs:
+        ray.cancel(ref)
+    _, running = ray.wait(refs, num_returns=len(refs), timeout=CANCEL_GRACE_S)
+    for ref in running:
+        ray.cancel(ref, force=True)
+    ray.wait(running, num_returns=len(running), timeout=CANCEL_GRACE_S)
 
 
 def _sila2_environment() -> dict[str, str]:

@@ -245,3 +245,31 @@ def test_a_trial_on_a_node_gets_the_drivers_world_and_layout_as_files_of_its_own
     assert layout_path(local.layouts_dir, SEED).read_text() == "name: random layout\n"
     assert local.stack.ca_file.parent == node and local.stack.domain_id is None  # reserved on its host
     assert local.stack.port_base >= stack.port_base and (local.jobs, local.record_dir) == (1, None)
+
+
+def test_sigterm_stops_a_cluster_campaign_its_trials_and_its_local_cluster(tmp_path: Path) -> None:
+    """Ray's core worker installs a SIGTERM handler that aborts the process: the bench puts its own
+    back, so SIGTERM stops the running trials and the summary says what was done (exit 130)."""
+    stack = ["--insecure", "--no-discovery", "--port-base", str(free_port_base(2 * PORTS_PER_WORKER))]
+    command = [*CLI, "bench", *stack, "--trials", "3", "--seed", str(SEED), "--json", "--cluster", "local"]
+    with subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as bench:
+        try:
+            deadline = time.monotonic() + 120
+            while not (robot_sides := _robot_sides_under(bench.pid)):  # a trial is running
+                assert bench.poll() is None and time.monotonic() < deadline, "no trial started"
+                time.sleep(0.5)
+            bench.send_signal(signal.SIGTERM)
+            stdout, stderr = bench.communicate(timeout=60)
+        finally:
+            if bench.poll() is None:
+                bench.kill()
+                bench.communicate(timeout=30)
+    assert bench.returncode == 130, stderr[-3000:]
+    assert json.loads(stdout)["error_kind"] == "interrupted"
+    deadline = time.monotonic() + 15
+    while any(map(_running, robot_sides)) and time.monotonic() < deadline:
+        time.sleep(0.5)
+    left = [pid for pid in robot_sides if _running(pid)]
+    for pid in left:
+        os.kill(pid, signal.SIGKILL)
+    assert not left, "the interrupted trial's robot side kept running"
