@@ -98,8 +98,12 @@ def _connected(ray: Any, address: str, local_cpus: int, verbose: bool) -> Iterat
     try:
         if address == LOCAL:
             scratch = tempfile.mkdtemp(prefix="ray-")  # Ray's socket paths must stay short
-            ray.init(
-                num_cpus=local_cpus, object_store_memory=LOCAL_OBJECT_STORE_BYTES, _temp_dir=scratch, **quiet
+            ray.init(  # "local": a new cluster even where `ray start` runs one (or RAY_ADDRESS names one)
+                address=LOCAL,
+                num_cpus=local_cpus,
+                object_store_memory=LOCAL_OBJECT_STORE_BYTES,
+                _temp_dir=scratch,
+                **quiet,
             )
         else:
             ray.init(address=address, **quiet)

@@ -154,13 +154,19 @@ def test_a_node_lost_mid_campaign_has_its_trial_run_again_on_the_head_marked_as_
     assert rerun[0]["error"] == "" or "lost" not in rerun[0]["error"]  # a robot's outcome, not the loss
     assert summary["rerun_trials"] == [{"seed": rerun[0]["seed"], "lost_runs": rerun[0]["lost_runs"]}]
     assert json.loads((report / "summary.json").read_text())["rerun_trials"] == summary["rerun_trials"]
-    deadline = time.monotonic() + 15  # the lost trial's robot side stops itself once its starter is gone
-    while any(map(_running, orphans)) and time.monotonic() < deadline:
+    # the lost trial's robot side stops itself once its starter is gone
+    assert not _still_running_after(orphans, 15.0), "the lost node's robot side kept running"
+
+
+def _still_running_after(pids: list[int], timeout_s: float) -> list[int]:
+    """The processes still running after `timeout_s`, killed then: never left to the next test."""
+    deadline = time.monotonic() + timeout_s
+    while any(map(_running, pids)) and time.monotonic() < deadline:
         time.sleep(0.5)
-    left = [pid for pid in orphans if _running(pid)]
-    for pid in left:  # never leave them to the next test
+    left = [pid for pid in pids if _running(pid)]
+    for pid in left:
         os.kill(pid, signal.SIGKILL)
-    assert not left, "the lost node's robot side kept running"
+    return left
 
 
 def _running(pid: int) -> bool:
@@ -256,7 +262,8 @@ def test_sigterm_stops_a_cluster_campaign_its_trials_and_its_local_cluster(tmp_p
         try:
             deadline = time.monotonic() + 120
             while not (robot_sides := _robot_sides_under(bench.pid)):  # a trial is running
-                assert bench.poll() is None and time.monotonic() < deadline, "no trial started"
+                if bench.poll() is not None or time.monotonic() > deadline:
+                    pytest.fail(f"no trial started; the bench printed:\n{bench.communicate()[1][-3000:]}")
                 time.sleep(0.5)
             bench.send_signal(signal.SIGTERM)
             stdout, stderr = bench.communicate(timeout=60)
@@ -266,10 +273,4 @@ def test_sigterm_stops_a_cluster_campaign_its_trials_and_its_local_cluster(tmp_p
                 bench.communicate(timeout=30)
     assert bench.returncode == 130, stderr[-3000:]
     assert json.loads(stdout)["error_kind"] == "interrupted"
-    deadline = time.monotonic() + 15
-    while any(map(_running, robot_sides)) and time.monotonic() < deadline:
-        time.sleep(0.5)
-    left = [pid for pid in robot_sides if _running(pid)]
-    for pid in left:
-        os.kill(pid, signal.SIGKILL)
-    assert not left, "the interrupted trial's robot side kept running"
+    assert not _still_running_after(robot_sides, 15.0), "the interrupted trial's robot side kept running"
