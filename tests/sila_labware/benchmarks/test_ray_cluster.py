@@ -193,7 +193,7 @@ def test_cluster_excludes_jobs_and_domain_id() -> None:
         assert done.returncode == 2 and f"--cluster and {flag[0]} exclude each other" in done.stderr
 
 
-def test_a_cluster_that_cannot_be_reached_ends_the_campaign_with_a_clear_error(tmp_path: Path) -> None:
+def test_a_cluster_that_cannot_be_reached_ends_the_campaign_with_a_clear_error() -> None:
     with socket.socket() as closed:  # a port nobody listens on
         closed.bind(("127.0.0.1", 0))
         port = closed.getsockname()[1]
@@ -202,9 +202,6 @@ def test_a_cluster_that_cannot_be_reached_ends_the_campaign_with_a_clear_error(t
     assert json.loads(done.stdout)["error_kind"] == "start_failed"
     done = bench_quickly("--cluster", "head-without-port")
     assert done.returncode == 1 and "expected HOST:PORT" in done.stderr
-    # `auto` with no cluster started on this machine (Ray looks for one in its temp folder)
-    done = bench_quickly("--cluster", "auto", environment={**os.environ, "RAY_TMPDIR": str(tmp_path)})
-    assert done.returncode == 1 and "cannot connect to the Ray cluster at auto" in done.stderr
 
 
 def test_a_cluster_with_no_cpu_ends_the_campaign_with_a_clear_error(
