@@ -15,8 +15,9 @@ The CPU is that of every process the campaign started, Ray's included, counted t
 `getrusage(RUSAGE_CHILDREN)` (`interleaved_cpu.measure`: this process is a child subreaper, so what
 Ray's processes leave behind is adopted and counted when it ends), and the CPU of each process as
 last seen in /proc every quarter second. The first is complete unless a process reaps a child
-without passing its CPU on, as a raylet that is not this process's child does with its workers
-(`--two-nodes`): there the samples count. Memory is the proportional set size (PSS: pages shared
+without passing its CPU on, as a raylet may do with its workers (it did on a two-node cluster, and
+on a local one once in two runs): the comparison is of the samples, which miss a process's last
+quarter second (about 2 % of a campaign's CPU). Memory is the proportional set size (PSS: pages shared
 between processes, such as a prewarmed robot side's, counted once in all) of the tree, sampled too.
 Threads: the main thread runs the campaigns; one thread samples /proc.
 """
@@ -114,7 +115,7 @@ for node in [*cluster.worker_nodes, cluster.head_node]:
 """
 """A cluster of one-CPU nodes in a process of its own (its daemons' CPU reaches RUSAGE_CHILDREN when
 it ends), killed at the end rather than stopped. Its workers' CPU still does not: the raylets reap
-them (measured: about 0.5 CPU s per trial counted of about 6), so the samples of /proc count here."""
+them (measured: about 0.5 CPU s per trial counted of about 6), so the samples of /proc count."""
 
 
 def run_on_nodes(nodes: int, trials: int, seed: int) -> dict[str, Any]:
@@ -186,8 +187,8 @@ def main(argv: list[str] | None = None) -> int:
         cluster = run_on_nodes(args.jobs, args.trials, args.seed)
     else:
         cluster = run_one(["--cluster", "local"], args.trials, args.seed)
-    # rusage misses the workers of a cluster started apart (CLUSTER_SCRIPT): there, the samples
-    key = "sampled_cpu_seconds_per_trial" if args.two_nodes else "cpu_seconds_per_trial"
+    # rusage may miss Ray's workers (a raylet reaps them; CLUSTER_SCRIPT): the samples miss none
+    key = "sampled_cpu_seconds_per_trial"
     overhead = cluster[key] - workers[key]
     figures = {
         "workers": workers,
