@@ -9,8 +9,10 @@ What "the same trial" means here: the same seed draws the same disturbances, so 
 ends as its `--jobs` run does (outcome and cause). Its robot time and plate error are not repeatable
 to a simulation step or a millimetre: the robot side's clock also runs, at 1x wall time, while the
 robot software computes (campaign.py), so two `--jobs` runs of one seed already differ (measured:
-up to 1.7 s of about 70 s simulated, 1.6 mm of placement error). The bounds below are that spread
-with room for a loaded machine, not the step length the issue asked for (docs/benchmarks/index.md).
+up to 1.7 s of about 70 s simulated, 1.6 mm of placement error; on a loaded machine one trial's
+robot time once differed by 17 %). So the test compares what the seed decides (outcome, cause, the
+steps run) and the placement error within 3 mm, not robot time to the step length the issue asked
+for (docs/benchmarks/index.md).
 """
 
 from __future__ import annotations
@@ -40,7 +42,6 @@ SEED = 4242
 # Plate nests mounted off their place by 4 mm (one standard deviation; the default is 1): the first
 # seed's plate misses its destination nest (positioning, also at 8 mm), the second's is delivered.
 FAULTS = ("--nest-error-mm", "4")
-ROBOT_TIME_SPREAD = 0.15  # share of the robot time two runs of one seed may differ by (see above)
 PLATE_ERROR_SPREAD_MM = 3.0
 # On the machine's own address, not 127.0.0.1: a Ray driver in another process turns a loopback
 # address into the machine's before it connects (ray._private.services.resolve_ip_for_localhost).
@@ -96,7 +97,8 @@ def test_trials_on_two_nodes_end_as_their_seeds_jobs_run(
     for seed, outcome in by_seed(summary).items():
         alone = expected[seed]
         assert (outcome["success"], outcome["cause"]) == (alone["success"], alone["cause"]), seed
-        assert outcome["sim_seconds"] == pytest.approx(alone["sim_seconds"], rel=ROBOT_TIME_SPREAD), seed
+        # the same steps ran (to the same failing one); robot time is not compared (see above)
+        assert [step["name"] for step in outcome["steps"]] == [step["name"] for step in alone["steps"]], seed
         if outcome["success"]:
             assert outcome["plate_position_error_mm"] == pytest.approx(
                 alone["plate_position_error_mm"], abs=PLATE_ERROR_SPREAD_MM
