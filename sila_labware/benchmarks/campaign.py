@@ -82,8 +82,9 @@ class TrialOutcome:
     plate_position_error_mm: float | None
     steps: list[dict[str, Any]] = field(default_factory=list)
     world: str = ""  # the world file the trial ran in (a generated layout's, with --random-layouts)
-    lost_runs: list[str] = field(default_factory=list)  # earlier runs whose worker died, and why
+    lost_runs: list[str] = field(default_factory=list)  # earlier runs whose worker or node died, and why
     remaining: list[dict[str, Any]] = field(default_factory=list)  # RemainingCheck per step, as dicts
+    node: str = ""  # with --cluster: the host and Ray node that ran it (where, never what: not a result)
 
 
 PORTS_PER_WORKER = 10  # SiLA ports a worker may use from its base: the robot's and up to 9 stations'
@@ -325,7 +326,7 @@ def summarize(outcomes: list[TrialOutcome], levels: dict[str, float], seed: int)
         "remaining_time": remaining_time.summary(
             [RemainingCheck.from_dict(check) for outcome in outcomes for check in outcome.remaining]
         ),
-        # infrastructure, not the robot: trials run again because their worker process died
+        # infrastructure, not the robot: trials run again because their worker process or node died
         "rerun_trials": [{"seed": o.seed, "lost_runs": o.lost_runs} for o in outcomes if o.lost_runs],
         "levels": levels,
         "outcomes": [asdict(o) for o in outcomes],
@@ -371,13 +372,16 @@ def format_table(summary: dict[str, Any]) -> str:
     if reruns:
         seeds = ", ".join(str(rerun["seed"]) for rerun in reruns)
         lines.append(
-            f"run again after their worker process died (infrastructure, not counted as failures): "
+            f"run again after their worker process died or their cluster node was lost (infrastructure, "
+            f"not counted as failures): "
             f"{len(reruns)} trial(s), seeds {seeds}"
         )
     if "elapsed_wall_seconds" in summary and summary["trials"]:
         elapsed = summary["elapsed_wall_seconds"]
+        cluster = summary.get("cluster")
+        where = f"the Ray cluster {cluster}" if cluster else f"{summary['jobs']} worker(s)"
         lines.append(
-            f"elapsed: {elapsed:.0f} s for {summary['trials']} trial(s) on {summary['jobs']} worker(s), "
+            f"elapsed: {elapsed:.0f} s for {summary['trials']} trial(s) on {where}, "
             f"{elapsed / summary['trials']:.1f} s per trial"
         )
     for failed in summary["failed_trials"]:

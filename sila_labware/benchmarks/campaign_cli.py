@@ -1,7 +1,7 @@
 """`sila-labware bench`: arguments and the command; `demo --record`: pictures of one run.
 
-    sila-labware bench --trials N --seed S [--world FILE | --random-layouts] [--jobs N] [--json]
-                       [--report DIR] [--replay SEED] [--level-scale X]
+    sila-labware bench --trials N --seed S [--world FILE | --random-layouts] [--json]
+                       [--jobs N | --cluster ADDRESS] [--report DIR] [--replay SEED] [--level-scale X]
                        [--nav-error-mm MM ...one flag per disturbance level]
     sila-labware bench --save-layout SEED FILE
 
@@ -18,6 +18,7 @@ import os
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
@@ -38,6 +39,7 @@ from sila_labware.benchmarks.random_layouts import (
     keep_failed_layouts,
     save_layout,
 )
+from sila_labware.benchmarks.ray_campaign import ClusterError, run_cluster_campaign
 from sila_labware.benchmarks.workers import run_parallel_campaign
 from sila_labware.deployment import json_outcome
 from sila_labware.deployment.json_outcome import JsonOutput, outcome_fields
@@ -89,9 +91,17 @@ def add_bench_arguments(bench: argparse.ArgumentParser) -> None:
     bench.add_argument(
         "--jobs",
         type=int,
-        default=len(os.sched_getaffinity(0)),  # the cores this process may run on
+        default=None,  # the cores this process may run on (validate_bench), unless --cluster
         help="trials run side by side, each with its own robot side, SiLA ports (--port-base + 10 per "
-        "worker) and ROS domain (default: the cores, %(default)s)",
+        f"worker) and ROS domain (default: the cores, {len(os.sched_getaffinity(0))})",
+    )
+    bench.add_argument(
+        "--cluster",
+        default=None,
+        metavar="ADDRESS",
+        help="run the trials as tasks on a Ray cluster: HOST:PORT of its head, 'auto' (the cluster "
+        "`ray start` runs on this machine) or 'local' (one started here, on the cores); each trial "
+        "takes one CPU and reserves its SiLA ports (from --port-base) and ROS domain on its host",
     )
     bench.add_argument("--json", action="store_true", help="print one JSON object with the results")
     bench.add_argument(
@@ -118,6 +128,12 @@ def add_bench_arguments(bench: argparse.ArgumentParser) -> None:
 def validate_bench(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
     if args.trials < 1:
         parser.error(f"--trials {args.trials}: need at least one")
+    if args.cluster is not None:
+        for flag, given in (("--jobs", args.jobs is not None), ("--domain-id", args.domain_id is not None)):
+            if given:
+                parser.error(f"--cluster and {flag} exclude each other (the cluster places the trials)")
+    if args.jobs is None:
+        args.jobs = len(os.sched_getaffinity(0))
     if args.jobs < 1:
         parser.error(f"--jobs {args.jobs}: need at least one")
     if args.port_base + PORTS_PER_WORKER * args.jobs > 65535:
@@ -233,9 +249,14 @@ def _run_and_report(args: argparse.Namespace, options: CampaignOptions) -> int:
             with trials_log.open("a") as log_file:
                 log_file.write(json.dumps(asdict(outcome)) + "\n")
 
-    run = run_campaign if options.jobs == 1 else run_parallel_campaign
     started = time.monotonic()
-    outcomes = run(options, progress_stream=sys.stderr, on_trial=on_trial)
+    try:
+        outcomes = _run(args.cluster, options, on_trial)
+    except ClusterError as error:
+        sys.stderr.write(f"bench: {error}\n")
+        if args.json:
+            JsonOutput.write_failure(str(error), json_outcome.START_FAILED, 1)
+        return 1
     elapsed_s = time.monotonic() - started
     kept = []
     if args.report is not None and options.layouts_dir is not None:
@@ -243,6 +264,7 @@ def _run_and_report(args: argparse.Namespace, options: CampaignOptions) -> int:
     shown_levels = {level.flag.removeprefix("--"): levels[level.field] for level in LEVEL_FLAGS}
     summary = summarize(outcomes, shown_levels, first_seed)
     summary["jobs"] = options.jobs
+    summary["cluster"] = args.cluster  # None: the trials ran on this machine's workers
     summary["pace"] = options.stack.pace  # None: unpaced, where the remaining times are not judged
     summary["random_layouts"] = options.layouts_dir is not None and options.layouts_flag == "--random-layouts"
     summary["random_obstacles"] = (
@@ -270,6 +292,16 @@ def _run_and_report(args: argparse.Namespace, options: CampaignOptions) -> int:
         if args.replay is not None:
             sys.stdout.write(f"replayed: {REPLAY_REPEATS}\n")
     return exit_code
+
+
+def _run(
+    cluster: str | None, options: CampaignOptions, on_trial: Callable[[TrialOutcome], None] | None
+) -> list[TrialOutcome]:
+    """The campaign's trials in this process, on workers, or on a Ray cluster."""
+    if cluster is not None:
+        return run_cluster_campaign(options, cluster, progress_stream=sys.stderr, on_trial=on_trial)
+    run = run_campaign if options.jobs == 1 else run_parallel_campaign
+    return run(options, progress_stream=sys.stderr, on_trial=on_trial)
 
 
 def _outcome(summary: dict[str, Any], trials: int, exit_code: int) -> dict[str, Any]:

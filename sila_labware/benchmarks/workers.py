@@ -52,21 +52,33 @@ _worker_index = 0  # in a worker process: its index, which sets its ports and RO
 _started_dir = ""  # in a worker process: where it notes each trial it starts (a file per seed)
 
 
-def _start_worker(indices: multiprocessing.Queue, levels: dict[str, int], started_dir: str) -> None:
-    """A worker's set-up: its index; a ROS domain of its own; logging as the parent's; signals
-    unwind the running trial."""
-    global _worker_index, _started_dir
-    _worker_index, _started_dir = indices.get(), started_dir
+def log_levels() -> dict[str, int]:
+    """The campaign's log levels, for `prepare_trial_process` in the processes that run its trials."""
+    return {name: logging.getLogger(name or None).getEffectiveLevel() for name in ("", "sila_labware")}
+
+
+def prepare_trial_process(levels: dict[str, int]) -> None:
+    """Set up a process that runs trials one after the other (a worker here, a Ray worker): a ROS
+    domain of its own, logging as the campaign's."""
     # The parent's ROS_DOMAIN_ID would put every worker in one domain: without --domain-id each
     # worker reserves its own (ros_bridge.domain: a lock per id, held while the worker lives).
     os.environ.pop("ROS_DOMAIN_ID", None)
-    from sila_labware.deployment.processes import interrupt_between_starts
     from sila_labware.servers.refusal_log import install_refusal_log_filter
 
     logging.basicConfig(format="%(asctime)s %(levelname)s %(name)s: %(message)s")
     for name, level in levels.items():
         logging.getLogger(name or None).setLevel(level)
     install_refusal_log_filter()
+
+
+def _start_worker(indices: multiprocessing.Queue, levels: dict[str, int], started_dir: str) -> None:
+    """A worker's set-up: its index; a ROS domain of its own; logging as the parent's; signals
+    unwind the running trial."""
+    global _worker_index, _started_dir
+    _worker_index, _started_dir = indices.get(), started_dir
+    prepare_trial_process(levels)
+    from sila_labware.deployment.processes import interrupt_between_starts
+
     signal.signal(signal.SIGINT, interrupt_between_starts)
     signal.signal(signal.SIGTERM, interrupt_between_starts)
 
@@ -131,10 +143,10 @@ def run_parallel_campaign(
     `trial` runs one trial in a worker (a module-level function, for the spawned workers)."""
     progress = CampaignProgress(progress_stream, options.trials)
     outcomes: list[TrialOutcome] = []
-    levels = {name: logging.getLogger(name or None).getEffectiveLevel() for name in ("", "sila_labware")}
+    levels = log_levels()
     waiting = [options.seed + index for index in range(options.trials)]
     lost_runs: dict[int, list[str]] = {}  # seed -> why each of its runs so far lost its worker
-    report = _Recorder(outcomes, progress, on_trial, replay_flags(options), lost_runs)
+    report = Recorder(outcomes, progress, on_trial, replay_flags(options), lost_runs)
     while waiting:
         # a trial that lost its worker runs again alone: a second death then is its own
         again = [seed for seed in waiting if seed in lost_runs]
@@ -148,8 +160,9 @@ def run_parallel_campaign(
 
 
 @dataclass
-class _Recorder:
-    """Where finished trials go (see `record_outcome`), each with the runs of it a dead worker lost."""
+class Recorder:
+    """Where finished trials go (see `record_outcome`), each with the runs of it a dead worker (or a
+    lost cluster node, ray_campaign.py) lost."""
 
     outcomes: list[TrialOutcome]
     progress: CampaignProgress
@@ -168,7 +181,7 @@ def _run_pool(
     options: CampaignOptions,
     seeds: list[int],
     levels: dict[str, int],
-    report: _Recorder,
+    report: Recorder,
     trial: Callable[[CampaignOptions, int, bool], Any],
     jobs: int,
 ) -> list[int]:
@@ -209,7 +222,7 @@ def _run_pool(
 
 
 def _after_a_lost_worker(
-    futures: dict[Future[TrialOutcome], int], lost: _Lost, report: _Recorder
+    futures: dict[Future[TrialOutcome], int], lost: _Lost, report: Recorder
 ) -> list[int]:
     """A worker died: the trials that ended count; those that had begun and not ended run again (which
     of them crashed its worker cannot be told) unless a worker died under them before; the rest

@@ -42,6 +42,8 @@ DIRECTIVES = {
 }
 INSTALL_TOOLS = {"pip", "pytest", "cd", "python3.11", "lab-venv/bin/pip", "lab-venv/bin/sila-labware"}
 RUN_VERBS = {"setup", "test", "docs", "demo", "serve", "bench", "world", "bluesky-demo"}
+# Ray's own command line, installed with the project (pinned in pyproject.toml), for `bench --cluster`
+RAY_VERBS = {"start", "stop", "status"}
 DEFAULT_PORTS = (50052, 50053, 50054)  # what `serve` takes without --port-base: robot, station_a, station_b
 
 
@@ -66,6 +68,8 @@ def shell_problem(line: str) -> str | None:
     program = words[0]
     if program in ("sila-labware", ".venv/bin/sila-labware") or program in INSTALL_TOOLS:
         return None
+    if program in ("ray", ".venv/bin/ray"):
+        return None if len(words) > 1 and words[1] in RAY_VERBS else f"ray has no verb we document: {line}"
     if program == "./run":
         return None if len(words) == 1 or words[1] in RUN_VERBS else f"./run has no verb {words[1]!r}"
     if program in ("python", ".venv/bin/python"):
