@@ -18,7 +18,6 @@ them); here they are flags in mm, degrees and percent. Threads: the caller's (th
 from __future__ import annotations
 
 import logging
-import signal
 import statistics
 import sys
 import time
@@ -28,6 +27,7 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from sila_labware.benchmarks.levels import levels_json
+from sila_labware.benchmarks.stop_deadline import stop_within
 from sila_labware.client import remaining_time
 from sila_labware.client.remaining_time import RemainingCheck
 from sila_labware.deployment.demo import MISPLACED, DemoReport, run_demo
@@ -131,20 +131,6 @@ def layout_path(layouts_dir: Path, trial_seed: int) -> Path:
     return layouts_dir / f"layout_{trial_seed}.yaml"
 
 
-def stop_within(stop: Callable[[], None], deadline_s: int | None) -> None:
-    """`stop()`, and with `deadline_s` the kernel ends this process if it takes longer (SIGALRM's
-    default action: no Python code has to run for it)."""
-    if deadline_s is None:
-        stop()
-        return
-    signal.signal(signal.SIGALRM, signal.SIG_DFL)
-    signal.alarm(deadline_s)
-    try:
-        stop()
-    finally:
-        signal.alarm(0)
-
-
 def run_trial(
     options: CampaignOptions,
     trial_seed: int,
@@ -155,10 +141,7 @@ def run_trial(
     """One fresh deployment, one standard transfer, stop. Never raises for a failed transfer.
 
     `stop_deadline_s` (a campaign's worker process only): if stopping the deployment takes longer,
-    the kernel ends this process (SIGALRM's default action), which the campaign counts as a lost
-    worker and runs the trial again. Why the kernel: Fast DDS can spin for minutes destroying a
-    participant, inside rclpy while it holds the GIL (the bridge's node, seen in a 200-trial
-    campaign), and then no Python code in the process runs again, a watchdog thread included."""
+    the kernel ends this process, which the campaign counts as a lost worker (`stop_deadline`)."""
     stack = trial_stack(options, trial_seed, worker)
     if record_dir is not None:
         stack = replace(

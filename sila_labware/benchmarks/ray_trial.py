@@ -28,6 +28,7 @@ from sila_labware.benchmarks.campaign import (
     layout_path,
     run_trial,
 )
+from sila_labware.benchmarks.stop_deadline import STOP_DEADLINE_S
 from sila_labware.benchmarks.workers import prepare_trial_process
 from sila_labware.deployment.port_blocks import reserve_port_block
 
@@ -73,7 +74,7 @@ def run_trial_on_node(
     try:
         local = options_on_node(options, trial_seed, files, scratch)
         frames_dir = scratch / "frames" if record else None
-        outcome = run_trial(local, trial_seed, frames_dir)
+        outcome = run_trial(local, trial_seed, frames_dir, stop_deadline_s=STOP_DEADLINE_S)
         layouts = options.layouts_dir
         world = options.stack.world if layouts is None else layout_path(layouts, trial_seed)
         frames = _read_frames(frames_dir)

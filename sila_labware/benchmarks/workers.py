@@ -42,12 +42,10 @@ from sila_labware.benchmarks.campaign import (
     replay_flags,
     run_trial,
 )
+from sila_labware.benchmarks.stop_deadline import STOP_DEADLINE_S
 
 logger = logging.getLogger(__name__)
 
-STOP_DEADLINE_S = 60
-"""A worker whose deployment takes longer than this to stop is ended by the kernel and its trial runs
-again (campaign.run_trial); a deployment stops in seconds (2 s per process at most before SIGKILL)."""
 _worker_index = 0  # in a worker process: its index, which sets its ports and ROS domain
 _started_dir = ""  # in a worker process: where it notes each trial it starts (a file per seed)
 

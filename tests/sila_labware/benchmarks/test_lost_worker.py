@@ -17,10 +17,10 @@ from sila_labware.benchmarks.campaign import (
     CampaignOptions,
     TrialOutcome,
     format_table,
-    stop_within,
     summarize,
 )
 from sila_labware.benchmarks.levels import default_level_values
+from sila_labware.benchmarks.stop_deadline import stop_within
 from sila_labware.benchmarks.workers import run_parallel_campaign
 from sila_labware.deployment.stack import DeploymentOptions
 
