@@ -4,6 +4,8 @@ Why: a killed participant leaves about 0.5 MB in /dev/shm for ever; a campaign k
 their timeouts and tests kill what hangs, so a busy machine filled 0.96 GB in three hours. Real
 rclpy processes here: one killed with SIGKILL, one alive; their files aged on purpose so that the
 cleaner, which leaves young files alone (another test's participant may be starting), judges them.
+Other tests' deployments run the same cleaner meanwhile; that is what the living process's files
+must survive.
 """
 
 from __future__ import annotations
@@ -53,7 +55,9 @@ def test_a_killed_process_segments_go_and_a_living_ones_stay() -> None:
         killed.wait(timeout=10)
         _age(killed_locks | alive_locks)
         assert all((SHM_DIR / name).exists() for name in killed_locks)  # left behind by the kill
-        assert remove_dead_segments() >= 2 * len(killed_locks)
+        # another test's deployment may clean at the same moment (every start does): the files must be
+        # gone, whoever removed them
+        remove_dead_segments()
         for name in killed_locks:
             assert not (SHM_DIR / name).exists() and not (SHM_DIR / name.removesuffix("_el")).exists()
         for name in alive_locks:
