@@ -71,10 +71,16 @@ def test_no_step_of_a_transfer_is_faster_than_its_minimum_under_the_limits_it_ra
     assert len(rows) > 20
     faster = [(step, took, least) for step, took, least, _moved in rows if took < least - STEP_TOLERANCE_S]
     assert not faster, faster
-    # the minima follow the file: the torso's 0.17 m rise beside the drive to the first station
-    drive = next(moved for step, _took, _least, moved in rows if step.startswith("GetLabware:navigate"))
-    rise = re.search(r"torso_lift_joint 0\.17 m of \d+ joints \(([\d.]+) s\)", drive)
-    assert rise is not None, drive
+    # the minima follow the file: the torso's 0.17 m rise to the bench height at the first station
+    # (beside the final approach, or beside the drive when drive_posture raises it there)
+    rises = [
+        found
+        for step, _took, _least, moved in rows
+        if step.startswith("GetLabware:")
+        and (found := re.search(r"torso_lift_joint 0\.17 m of \d+ joints \(([\d.]+) s\)", moved))
+    ]
+    assert rises, rows
+    rise = rises[0]
     torso_speed = 0.05 if slow else 0.07
     assert float(rise[1]) == pytest.approx(0.17 / torso_speed + RAMP_S, abs=0.05)
 
