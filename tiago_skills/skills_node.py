@@ -61,11 +61,8 @@ class RobotSkills:
             speed_scale=lambda: float(node.get_parameter("speed_scale").value),
             seed=seed,
             plate_widths=tuple(sorted({t.width for t in world.labware_types.values()})),
-            # Off: with the torso raised beside the drive to a station (tiago_skills.drive_posture),
-            # a GetLabware cancelled early left both elbows moving 0.4 rad after the robot reported
-            # Idle (test_cancel_command_ends_a_running_get_labware_and_the_inventory_stays_true);
-            # on again once that is understood (the benchmarks page has what it wins).
-            station_pois=frozenset(),
+            # a drive to a station's POI raises the torso to the bench height (drive_posture)
+            station_pois=frozenset(station.poi for station in world.stations),
         )
         self.marker_motion = MarkerMotionBehaviour(world, self.behaviours, motions.hotel)
         self.actions = RobotActionServers(

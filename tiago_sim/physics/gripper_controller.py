@@ -79,7 +79,7 @@ class Gripper:
             [0, 0, 0],
             physicsClientId=client,
         )
-        p.changeConstraint(gear, gearRatio=-1, maxForce=GEAR_FORCE, erp=0.2, physicsClientId=client)
+        body.forces.constraint(gear, gearRatio=-1, maxForce=GEAR_FORCE, erp=0.2)
         self.command(rm.FINGER_TRAVEL)
 
     def command(self, finger_position: float, force_n: float | None = None) -> None:
@@ -139,7 +139,7 @@ class Gripper:
         """Remove the attach (once the opening pads have left the plate, or when the grip cannot hold
         it)."""
         if self.attach_constraint is not None:
-            p.removeConstraint(self.attach_constraint, physicsClientId=self.body.client)
+            self.body.forces.remove_constraint(self.attach_constraint)
         self.attach_constraint = None
         self.attached_id = ""
         self._grip_monitor = None

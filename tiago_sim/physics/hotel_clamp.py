@@ -59,7 +59,7 @@ class HotelClamp:
         for name in [labware_id] if labware_id else list(self.constraints):
             constraint = self.constraints.pop(name, None)
             if constraint is not None:
-                p.removeConstraint(constraint, physicsClientId=self.body.client)
+                self.body.forces.remove_constraint(constraint)
                 log.debug("hotel clamp opened on %s", name)
 
     def release_pushed(self, friction: float) -> list[str]:

@@ -26,6 +26,7 @@ import pybullet as p
 from tiago_description import robot_model
 from tiago_description import transforms as tf
 from tiago_description.robot_limits import active_limits
+from tiago_sim.physics.step_forces import StepForces
 
 BASE_CONSTRAINT_FORCE = 1e5
 ARM_POSITION_GAIN = 0.3
@@ -42,6 +43,7 @@ class RobotBody:
 
     def __init__(self, client: int, T_world_base: np.ndarray) -> None:
         self.client = client
+        self.forces = StepForces(client)  # every force limit, set again when the step changes
         position, quat = tf.to_pose(T_world_base)
         # Fixed links are merged into their moving parent (half the links, twice the speed); their
         # frames stay reachable through ``frame_offsets`` (moving link, T_link_frame) from the URDF.
@@ -90,7 +92,7 @@ class RobotBody:
             childFrameOrientation=quat.tolist(),
             physicsClientId=client,
         )
-        p.changeConstraint(self.base_constraint, maxForce=BASE_CONSTRAINT_FORCE, physicsClientId=client)
+        self.forces.constraint(self.base_constraint, maxForce=BASE_CONSTRAINT_FORCE)
         # every link in a collision group of its own, colliding with everything as before, so that
         # ray tests can leave the robot out (the base laser never sees it)
         for link in self.link_index.values():
@@ -180,17 +182,15 @@ class RobotBody:
             target = float(commanded) - offset  # the true position the motor drives to
             target = min(max(target, lower), upper) if upper > lower else target
             self.targets[name] = target + offset
-            p.setJointMotorControl2(
+            self.forces.position_motor(
                 self.id,
                 self.joint_index[name],
-                p.POSITION_CONTROL,
                 targetPosition=target,
                 targetVelocity=(velocities or {}).get(name, 0.0),
                 force=effort * force_scale,
                 maxVelocity=velocity_limit,
                 positionGain=ARM_POSITION_GAIN,
                 velocityGain=1.0,
-                physicsClientId=self.client,
             )
 
     def track(self, names: list[str], positions: np.ndarray, velocities: np.ndarray) -> None:
@@ -218,16 +218,14 @@ class RobotBody:
         clipped = np.minimum(np.maximum(np.asarray(positions) - offsets, lower), upper)
         self.targets.update(zip(names, (clipped + offsets).tolist(), strict=True))
         clipped = clipped.tolist()
-        p.setJointMotorControlArray(
+        self.forces.position_motors(
             self.id,
             indices,
-            p.POSITION_CONTROL,
-            targetPositions=clipped,
-            targetVelocities=np.asarray(velocities, dtype=float).tolist(),
-            forces=forces,
-            positionGains=position_gains,
-            velocityGains=velocity_gains,
-            physicsClientId=self.client,
+            clipped,
+            np.asarray(velocities, dtype=float).tolist(),
+            forces,
+            position_gains,
+            velocity_gains,
         )
 
     def link_pose(self, link: str) -> np.ndarray:
@@ -268,7 +266,7 @@ class RobotBody:
             parentFrameOrientation=parent_quat,
             physicsClientId=client,
         )
-        p.changeConstraint(constraint, maxForce=max_force, physicsClientId=client)
+        self.forces.constraint(constraint, maxForce=max_force)
         return constraint
 
     def frame_on_link(self, frame: str) -> tuple[int, np.ndarray]:

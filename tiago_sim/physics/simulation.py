@@ -216,6 +216,7 @@ class Simulation:
         if step != self._step:
             self._step = step
             p.setPhysicsEngineParameter(fixedTimeStep=step, erp=erp, physicsClientId=self.client_id)
+            self.robot.forces.restate()  # force limits are impulses per step in PyBullet (step_forces)
         return step
 
     def busy(self) -> bool:

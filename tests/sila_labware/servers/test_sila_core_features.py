@@ -111,11 +111,20 @@ def assert_base_at_rest(cell: Cell) -> None:
 
 
 def assert_joints_at_rest(cell: Cell) -> None:
+    """No joint moves more than 1 mrad over a second of wall time (many seconds simulated), counted
+    from half a second of robot time after the report: a held joint settles by a few mrad when the
+    physics step changes as the last motion ends (the step's length sets a position motor's
+    stiffness: docs/explanation/simulation-model.md)."""
     runtime = cell.deployment.runtime
     assert runtime is not None
     joints = TopicMirror(runtime, JointState, "/joint_states", QoSProfile(depth=5))
+
+    def stamp_s(message: JointState) -> float:
+        return message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
+
     try:
-        before = joints.wait_for_message(10.0)
+        settled_from = stamp_s(joints.wait_for_message(10.0)) + 0.5
+        before = joints.wait_for_message(10.0, lambda m: stamp_s(m) >= settled_from)
         time.sleep(1.0)
         after = joints.wait_for_message(10.0, lambda m: m.header.stamp != before.header.stamp)
     finally:
