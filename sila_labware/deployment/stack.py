@@ -41,7 +41,7 @@ from sila_labware.device.robot_controller import RobotController
 from sila_labware.device.simulated_lab import SimulatedLab
 from sila_labware.device.station_controller import StationController
 from sila_labware.servers.robot_server.server import Server as RobotServer
-from sila_labware.servers.serving import start_sila_server
+from sila_labware.servers.serving import start_sila_server, stop_sila_server
 from sila_labware.servers.station_server.server import Server as StationServer
 from sila_labware.servers.tls import CertificateAuthority
 
@@ -312,7 +312,6 @@ class Deployment:
 
 def _stop_server(server: SilaServer) -> None:
     try:
-        if server.running:
-            server.stop(grace_period=0.2)
+        stop_sila_server(server, grace_period=0.2)
     except Exception:  # noqa: BLE001 - stopping anyway; the reason goes to the log
         logger.warning("stopping SiLA server %s raised", server.server_name, exc_info=True)

@@ -7,13 +7,14 @@ the kernel splits clients between them. Real sila2 servers and a real client ove
 from __future__ import annotations
 
 import socket
+import threading
 
 import pytest
 from sila2.client import SilaClient
 from sila2.server import SilaServer
 
 from sila_labware.servers import serving
-from sila_labware.servers.serving import PortInUseError, port_is_free, start_sila_server
+from sila_labware.servers.serving import PortInUseError, port_is_free, start_sila_server, stop_sila_server
 from tests.helpers.sila_stack import free_port_base
 
 
@@ -59,3 +60,21 @@ def test_a_port_held_by_any_listener_is_refused():
         with pytest.raises(PortInUseError, match=f"127.0.0.1:{port}"):
             start_sila_server(server, "127.0.0.1", port, authority=None, discovery=False)
         assert not server.running
+
+
+def _zeroconf_threads() -> int:
+    return sum(1 for thread in threading.enumerate() if thread.name.endswith("(_run_loop)"))
+
+
+def test_a_stopped_server_leaves_no_zeroconf_thread_behind():
+    """sila2 opens a Zeroconf per server, announcing or not, and never closes it; a campaign worker
+    starts three servers a trial."""
+    before = _zeroconf_threads()
+    for name in ("One", "Two", "Three"):
+        server = bare_server(name)
+        port = free_port_base(1)
+        start_sila_server(server, "127.0.0.1", port, authority=None, discovery=False)
+        assert SilaClient("127.0.0.1", port, insecure=True).SiLAService.ServerName.get() == name
+        stop_sila_server(server)
+        assert not server.running
+    assert _zeroconf_threads() == before
