@@ -97,13 +97,17 @@ def test_a_trajectory_over_two_controllers_arrives_in_the_ports_time(
     _names, path = profiled_path(start, trajectory.points, velocity_limits())
     began = hardware.now()
     execution = finished(hardware.follow_joint_trajectory(trajectory))
-    took = hardware.now() - began
+    ended = hardware.now()
     assert execution.success, execution.message
     now = hardware.joint_positions()
     assert [now[name] for name in target] == pytest.approx(list(target.values()), abs=0.01)
-    # the controllers ran the port's timing: the same duration, to the clock's ticks (20 a second of
-    # wall time, 0.25 s of robot time at the pace of 5) at either end
-    assert took == pytest.approx(path.duration, abs=0.75)
+    # The controllers ran the port's timing: never faster than it (to one tick of the clock, 0.25 s of
+    # robot time at the pace of 5), and slower only by the goal's settling (up to 1.5 s) and the
+    # result's way back to this process, which the pace multiplies: 0.1 s of wall latency is 0.5 s of
+    # robot time (1.2 to 1.7 s measured here for a 1.0 s profile, 1.8 s in a clean-clone CI run). A
+    # controller timing the move its own way (play_motion2's approach: about 4 times slower) fails.
+    took = ended - began
+    assert path.duration - 0.3 <= took <= path.duration + 2.0, (took, path.duration)
 
 
 def test_a_group_in_motion_is_busy_and_a_cancel_stops_it(robot: tuple[RosHardware, RosCaller]) -> None:
