@@ -49,7 +49,7 @@ from sila_labware.deployment.processes import ros_environment
 from sila_labware.deployment.stack import join_ros_domain
 from sila_labware.device.robot_controller import RobotController
 from sila_labware.servers.robot_server.server import Server as RobotServer
-from sila_labware.servers.serving import start_sila_server
+from sila_labware.servers.serving import start_sila_server, stop_sila_server
 
 logger = logging.getLogger(__name__)
 
@@ -218,7 +218,7 @@ def run_latency_bench(
         sila_accepts, sila_feedbacks = asyncio.run(measure_sila(port_base, peer, calls))
     finally:
         if server is not None:
-            server.stop(grace_period=0.2)
+            stop_sila_server(server, grace_period=0.2)
         runtime.stop(timeout_s=1.0)
         peer.stop()
     report = LatencyReport(

@@ -25,7 +25,7 @@ from labware_model.workcell import WorkcellDescription
 from ros_bridge.robot_link import RobotLink
 from ros_bridge.runtime import RosRuntime
 from sila_labware.servers.refusal_log import install_refusal_log_filter
-from sila_labware.servers.serving import start_sila_server
+from sila_labware.servers.serving import start_sila_server, stop_sila_server
 from sila_labware.servers.tls import CertificateAuthority
 
 logger = logging.getLogger(__name__)
@@ -79,6 +79,6 @@ def run_standalone(
         sys.stderr.write(f"{parser.prog}: {error}\n")
         return 1
     finally:
-        if server is not None and server.running:
-            server.stop(grace_period=0.5)
+        if server is not None:
+            stop_sila_server(server, grace_period=0.5)
         runtime.stop()

@@ -33,6 +33,7 @@ from sila_labware.servers.robot_server.cancellable_commands import CancellableCo
 from tests.helpers.sila_stack import client_for, start_stack
 from tests.helpers.sim_parameters import set_node_parameter
 from tests.helpers.transfer_steps import Cell, finish, wait_for_progress
+from tiago_ros_hardware.topics import stamp_seconds
 
 PLATE = "plate_001"
 A1, B1 = ("station_a", 1), ("station_b", 1)
@@ -119,12 +120,9 @@ def assert_joints_at_rest(cell: Cell) -> None:
     assert runtime is not None
     joints = TopicMirror(runtime, JointState, "/joint_states", QoSProfile(depth=5))
 
-    def stamp_s(message: JointState) -> float:
-        return message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
-
     try:
-        settled_from = stamp_s(joints.wait_for_message(10.0)) + 0.5
-        before = joints.wait_for_message(10.0, lambda m: stamp_s(m) >= settled_from)
+        settled_from = stamp_seconds(joints.wait_for_message(10.0)) + 0.5
+        before = joints.wait_for_message(10.0, lambda m: stamp_seconds(m) >= settled_from)
         time.sleep(1.0)
         after = joints.wait_for_message(10.0, lambda m: m.header.stamp != before.header.stamp)
     finally:
