@@ -38,10 +38,12 @@ from sila_labware.benchmarks.ray_campaign import SILA2_ENVIRONMENT
 from tests.helpers.sila_stack import DEFAULT_WORLD, free_port_base
 from tests.sila_labware.benchmarks.test_bench import CLI, run_bench
 
-SEED = 4242
-# Plate nests mounted off their place by 4 mm (one standard deviation; the default is 1): the first
-# seed's plate misses its destination nest (positioning, also at 8 mm), the second's is delivered.
-FAULTS = ("--nest-error-mm", "4")
+SEED = 4247
+# Plate nests mounted off their place by 6 mm (one standard deviation; the default is 1): the first
+# seed's plate misses its destination nest by about 11 mm (positioning), the second's lands within
+# 0.3 mm, far from either side of the nest's tolerance (measured over two `--jobs` runs of 12 seeds;
+# at 4 mm the pair 4242/4243 had a borderline second trial that flipped either way).
+FAULTS = ("--nest-error-mm", "6")
 PLATE_ERROR_SPREAD_MM = 3.0
 # On the machine's own address, not 127.0.0.1: a Ray driver in another process turns a loopback
 # address into the machine's before it connects (ray._private.services.resolve_ip_for_localhost).

@@ -13,6 +13,7 @@ from sila2.server import MetadataDict
 
 from labware_model.holders import GRIPPER, UNKNOWN, HotelSlot, Nest, aboard
 from sila_labware.device.inventory import LabwareRecord
+from sila_labware.servers.published_values import PublishedValues
 
 from ..generated.labwareinventory import LabwareInventoryBase, LocateLabware_Responses, UnknownLabware
 
@@ -45,6 +46,7 @@ class LabwareInventoryImpl(LabwareInventoryBase):
     def __init__(self, parent_server: Server) -> None:
         super().__init__(parent_server=parent_server)
         self.robot = parent_server.robot
+        self.published = PublishedValues(self, "LabwareLocations")
         self._publish(self.robot.inventory.records())
         self.robot.inventory.add_listener(self._publish)
 
@@ -57,6 +59,7 @@ class LabwareInventoryImpl(LabwareInventoryBase):
         self.update_LabwareLocations(
             [location_structure(record, slot) for record in records if record.location != UNKNOWN]
         )
+        self.published.wait()
 
     def LocateLabware(self, LabwareUniqueID: str, *, metadata: MetadataDict) -> LocateLabware_Responses:
         record = self.robot.inventory.locate(LabwareUniqueID)

@@ -2,8 +2,9 @@
 
 Commands go to `RobotController` (dock, undock, drive, stop), each under its execution's cancel
 token (`cancellable_commands`) so that CancelController can stop it; the observable properties follow
-the robot side's /robot_state through the bridge's topic mirror. Listeners run on the ROS thread
-and only push values into sila2's queues.
+the robot side's /robot_state through the bridge's topic mirror. Listeners run on the ROS thread;
+they push values into sila2's queues and wait (bounded) until sila2 serves them, so that a client
+reading a property after a command's answer reads the state the command answered on.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from sila2.server import MetadataDict, ObservableCommandInstance
 from ros_bridge.workcell import RobotStatus
 from sila_labware.device.errors import CommandSequenceError, MotionFailed, ParameterError
 from sila_labware.device.inventory import Inventory
+from sila_labware.servers.published_values import PublishedValues
 from sila_labware.servers.sila_glue import progress_reporter, validation_error
 
 from ..generated.mobilerobotcontroller import (
@@ -73,6 +75,9 @@ class MobileRobotControllerImpl(MobileRobotControllerBase):
         super().__init__(parent_server=parent_server)
         self.robot = parent_server.robot
         self.commands = parent_server.cancellable_commands
+        self.published = PublishedValues(
+            self, "RobotPose", "RobotState", "CurrentPointOfInterest", "OnboardLabware"
+        )
         # Subscribers wait forever without a first value: publish the current state now.
         self._publish_status(self.robot.link.robot_status())
         self.robot.link.on_robot_status(self._publish_status)
@@ -88,6 +93,7 @@ class MobileRobotControllerImpl(MobileRobotControllerBase):
 
     def _publish_onboard(self, status: RobotStatus) -> None:
         self.update_OnboardLabware(onboard_items(status, self.robot.inventory))
+        self.published.wait()  # before the bridge wakes a command that answers on this status
 
     def get_PointsOfInterest(self, *, metadata: MetadataDict) -> list[PointOfInterestName]:
         return list(self.robot.workcell.pois)
