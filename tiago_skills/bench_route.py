@@ -1,11 +1,13 @@
-"""The arm's way from in front of a bench to above a nest, clear of the station's marker board and bench.
+"""The arm's way from in front of a bench to above a nest, clear of the station's marker board, its
+bench and the labware in its nests.
 
 Why: the marker stands on a board beside the row (furniture as a lab has it: 2 to 8 cm beyond the end
 nest's brackets), and the arm's usual ways to the end nest beside it, a straight tool line or one
 joint-space move, swept a finger, the wrist or a held plate into the board (random layouts 132035,
-132040, 132016); a joint-space move also dipped a finger into the bench top. The ways are planned
-first and checked against the board and the bench, placed where the marker is seen, with the robot
-model's collision shapes (`tiago_description.arm_clearance`); the first that keeps WAY_CLEARANCE_M
+132040, 132016); a joint-space move also dipped a finger into the bench top, and one swept a finger
+through the plate in the target nest (181006). The ways are planned first and checked against the
+board, the bench and the labware that may stand in the nests, placed where the marker is seen, with
+the robot model's collision shapes (`tiago_description.arm_clearance`); the first that keeps WAY_CLEARANCE_M
 runs, tried in this order, each to the grasp and then to its twin with the fingers swapped (an empty
 gripper only: a held plate keeps its orientation):
 
@@ -99,13 +101,42 @@ def station_boxes(station: Station, T_base_marker_seen: np.ndarray) -> list[Box]
     return [board_box(station, T_base_marker_seen), bench_box(station, T_base_marker_seen)]
 
 
+def largest_labware(labware_types: list[LabwareType]) -> tuple[float, float, float]:
+    """Length, width and height (m) that every labware type of the lab fits in."""
+    return (
+        max(t.length for t in labware_types),
+        max(t.width for t in labware_types),
+        max(t.height for t in labware_types),
+    )
+
+
+def nest_labware_boxes(
+    station: Station,
+    T_base_marker_seen: np.ndarray,
+    sub_positions: list[int],
+    size: tuple[float, float, float],
+) -> list[Box]:
+    """Labware standing in these nests (as large as `size`: length, width, height), placed where the
+    marker is seen: a joint-space move to the approach above a nest swept a finger through the plate
+    it came for and pushed it out of its nest (random layout 181006), which the robot then found
+    missing as it came down to grasp it."""
+    T_base_marker = upright_marker(T_base_marker_seen, station.T_table_marker())
+    height = size[2]
+    return [
+        Box(
+            f"the labware in {station.name} nest {sub_position}",
+            size,
+            T_base_marker @ station.T_marker_site(sub_position) @ tf.make_transform((0.0, 0.0, height / 2)),
+        )
+        for sub_position in sub_positions
+    ]
+
+
 def held_plate_box(labware_types: list[LabwareType], grasp: HotelGrasp) -> HeldBox:
     """The largest plate the lab has, as the gripper holds it: the grasping frame's x points down
     into the plate (its bottom `grasp_height_m` below the frame), y across its short side, z along its
     long side."""
-    length = max(t.length for t in labware_types)
-    width = max(t.width for t in labware_types)
-    height = max(t.height for t in labware_types)
+    length, width, height = largest_labware(labware_types)
     return HeldBox((height, width, length), tf.make_transform((grasp.grasp_height_m - height / 2, 0.0, 0.0)))
 
 
@@ -163,7 +194,7 @@ class BenchRoute:
         raise ActionAbort(
             ErrorCodes.IK_FAILED,
             f"no way to {np.round(targets[0][:3, 3], 3)} keeps {WAY_CLEARANCE_M * 1000:.0f} mm from "
-            f"the marker board and the bench: {'; '.join(tried)}",
+            f"the marker board, the bench and the labware in the nests: {'; '.join(tried)}",
         )
 
     def ways(

@@ -43,7 +43,13 @@ from tiago_skills.behaviours import (
     TOOL_SPEED_INTO_POCKET,
     RobotBehaviours,
 )
-from tiago_skills.bench_route import BenchRoute, held_plate_box, station_boxes
+from tiago_skills.bench_route import (
+    BenchRoute,
+    held_plate_box,
+    largest_labware,
+    nest_labware_boxes,
+    station_boxes,
+)
 from tiago_skills.goal_run import ActionAbort, GoalRun
 from tiago_skills.joint_commands import move_joints
 from tiago_skills.perception.aruco import detect_marker
@@ -95,6 +101,7 @@ class MarkerMotionBehaviour:
         self.grasp = grasp
         self.route = BenchRoute(behaviours)
         self.held_plate = held_plate_box(list(world.labware_types.values()), grasp)
+        self.largest_labware = largest_labware(list(world.labware_types.values()))
         self.kinematics = RobotKinematics()
         self._lock = threading.Lock()
         self.last_sighting: MarkerSighting | None = None
@@ -302,14 +309,14 @@ class MarkerMotionBehaviour:
             holding = self.behaviours.holding.get(arm, False)
             # An empty gripper may come down as either twin: the other one may have a clear way.
             targets = [T_base_target] if holding else [T_base_target, T_base_target @ FLIP_ABOUT_APPROACH]
+            # Any nest may hold labware (the skills do not read the nests' sensors), but the one a
+            # held plate goes into is empty (the sequencer checked it).
+            stocked = [n for n in range(1, station.sub_positions + 1) if not (holding and n == sub_position)]
+            boxes = station_boxes(station, sighting.T_base_marker) + nest_labware_boxes(
+                station, sighting.T_base_marker, stocked, self.largest_labware
+            )
             reached = self.route.move(
-                run,
-                arm,
-                targets,
-                speed,
-                (first, 1.0),
-                station_boxes(station, sighting.T_base_marker),
-                self.held_plate if holding else None,
+                run, arm, targets, speed, (first, 1.0), boxes, self.held_plate if holding else None
             )
             if reached:
                 self.behaviours.grasp_flipped[arm] = not self.behaviours.grasp_flipped.get(arm, False)

@@ -1,8 +1,10 @@
-"""The arm's way to the nest beside a station's marker board passes clear of the board, on real physics.
+"""The arm's way to the nest beside a station's marker board passes clear of the board, the bench and
+the plate in the nest, on real physics.
 
 Why: in random layout 132035 the empty gripper's joint-space move from "Benchtop" to the approach
 of the nest beside the board swept a finger 2.3 mm into the board (COLLISION), and in 132040 and
-132016 the wrist and a held plate met it. The skills now plan their ways first and check them with
+132016 the wrist and a held plate met it; in 181006 a joint-space move to the approach above a plate
+pushed that plate out of its nest. The skills now plan their ways first and check them with
 the robot model's collision shapes (tiago_skills.bench_route, tiago_description.arm_clearance).
 The fixture is 132035's station alone; the test stands in for perception only: it places the board
 where the robot's pose estimate and the world file put it.
@@ -24,12 +26,21 @@ from tiago_description.kinematics import RobotKinematics
 from tiago_description.motion_library import load_motions
 from tiago_sim.physics.simulation import Simulation
 from tiago_skills.behaviours import FLIP_ABOUT_APPROACH
-from tiago_skills.bench_route import WAY_CLEARANCE_M, BenchRoute, bench_box, board_box, station_boxes
+from tiago_skills.bench_route import (
+    WAY_CLEARANCE_M,
+    BenchRoute,
+    bench_box,
+    board_box,
+    largest_labware,
+    nest_labware_boxes,
+    station_boxes,
+)
 
 FIXTURE = Path(__file__).parent / "fixtures" / "board_beside_the_row.yaml"
 ARM = "right"
 NEST = 3  # beside the board
 TOOL_SPEED = 0.35
+PLATE = "plate_001"  # in nest 3
 
 
 @pytest.fixture(scope="module")
@@ -71,6 +82,21 @@ def run_way(sim: Simulation, trajectories) -> list:  # noqa: ANN001
     return [sim.run(sim.execute_trajectory(trajectory), timeout_s=60.0) for trajectory in trajectories]
 
 
+def labware_boxes(world: World, sim: Simulation) -> list[Box]:
+    """Every nest of the station as the skills count it when they come for a plate: stocked."""
+    station = world.station("labeler")
+    size = largest_labware(list(world.labware_types.values()))
+    return nest_labware_boxes(station, seen_marker(world, sim), [1, 2, 3], size)
+
+
+def way_boxes(world: World, sim: Simulation) -> list[Box]:
+    return station_boxes(world.station("labeler"), seen_marker(world, sim)) + labware_boxes(world, sim)
+
+
+def plate_shift_m(sim: Simulation, before: np.ndarray) -> float:
+    return float(np.linalg.norm(sim.plate_bottom_pose(PLATE)[:3, 3] - before[:3, 3]))
+
+
 def test_a_joint_space_move_the_model_refuses_touches_the_station_in_physics(
     world: World, sim: Simulation
 ) -> None:
@@ -107,12 +133,42 @@ def test_a_joint_space_move_the_model_refuses_touches_the_station_in_physics(
     assert any(f"touched labeler {name}" in outcome.message for name in crossed(way)), outcome.message
 
 
+def test_a_joint_space_move_through_the_plate_in_the_nest_pushes_it_in_physics(
+    world: World, sim: Simulation
+) -> None:
+    """The scenario of the labware boxes is real: a joint-space move to the approach above the plate
+    it comes for, clear of the board and the bench but through the plate by the model, moves the
+    plate in physics (in random layout 181006 it left its nest, and the grasp found nothing)."""
+    route = BenchRoute(behaviours(seed=0))
+    start = sim.joint_positions()
+    station = station_boxes(world.station("labeler"), seen_marker(world, sim))
+    labware = labware_boxes(world, sim)
+    through = None
+    for _index, way in route.ways(
+        ARM, start, approach_targets(world, sim), TOOL_SPEED, station + labware, None
+    ):
+        if isinstance(way, str) or way.name != "joint-space move":
+            continue
+        path = list(way.path)
+        if (
+            route.behaviours.planning.clearance(ARM, start, path, labware, None).distance_m < -0.01
+            and route.behaviours.planning.clearance(ARM, start, path, station, None).distance_m > 0
+        ):
+            through = way
+            break
+    assert through is not None, "no joint-space move crosses the plate alone here: the fixture lost its point"
+    before = sim.plate_bottom_pose(PLATE)
+    run_way(sim, through.trajectories)
+    assert plate_shift_m(sim, before) > 0.002
+
+
 def test_the_planned_way_reaches_the_nest_s_approach_and_touches_nothing(
     world: World, sim: Simulation
 ) -> None:
     route = BenchRoute(behaviours(seed=0))
     targets = approach_targets(world, sim)
-    boxes = station_boxes(world.station("labeler"), seen_marker(world, sim))
+    boxes = way_boxes(world, sim)
+    before = sim.plate_bottom_pose(PLATE)
     start = sim.joint_positions()
     index, way = route.plan(ARM, start, targets, TOOL_SPEED, boxes, None)
     assert (
@@ -123,6 +179,7 @@ def test_the_planned_way_reaches_the_nest_s_approach_and_touches_nothing(
         assert outcome.success, f"{way.name}: {outcome.error_code} {outcome.message}"
     reached = RobotKinematics().forward(sim.joint_positions(), f"gripper_{ARM}_grasping_frame")
     assert np.linalg.norm(reached[:3, 3] - targets[index][:3, 3]) < 0.005
+    assert plate_shift_m(sim, before) < 0.0005
 
 
 def test_the_way_around_keeps_clear_of_the_station_and_the_robot_in_physics(
@@ -131,7 +188,7 @@ def test_the_way_around_keeps_clear_of_the_station_and_the_robot_in_physics(
     """The last way, searched in joint space (tiago_skills.joint_rrt), asked for directly here: it
     reaches the target and touches nothing; its path keeps the clearance from the body too."""
     route = BenchRoute(behaviours(seed=0))
-    boxes = station_boxes(world.station("labeler"), seen_marker(world, sim))
+    boxes = way_boxes(world, sim)
     start = sim.joint_positions()
     target = approach_targets(world, sim)[0]
     way = route._around(ARM, start, target, boxes, None)
