@@ -16,8 +16,9 @@ microplate and a 96-well deep-well plate, both SBS footprint.
 
 Layout rules beyond the loader's: everything stays 0.3 m inside the floor's walls, and the straight
 drives between the dock's POI and the stations' POIs keep the hotel tray's turning circle
-(0.40 m) off every bench and the dock, since navigation drives straight from POI to POI today.
-Pure; any thread.
+(0.40 m) off every bench and the dock, since navigation drives straight from POI to POI today;
+and the planner finds a way from and to where the robot may stop near each POI (the stop error),
+the dock's included (`route_problems`). Pure; any thread.
 """
 
 from __future__ import annotations
@@ -107,7 +108,8 @@ def generate_layout(seed: int) -> dict[str, Any]:
 
 def route_problems(world: World) -> list[str]:
     """Why the robot could not drive this lab: two POIs with no planned path between them (`world
-    check`'s rule), or a station's working pose it could not leave for the dock. The drawing keeps
+    check`'s rule), a station's working pose it could not leave for the dock, or a stop near a POI
+    (the dock's or a station's) it could not leave or reach. The drawing keeps
     straight drives 0.40 m from the benches (the tray's turning circle), the planner wants 0.53 m
     and the folded arms' band, so a drawn lab could have a dock that no plan leaves."""
     paths = plan_poi_paths(world)
@@ -126,6 +128,16 @@ def route_problems(world: World) -> list[str]:
                 except PlanningError as error:
                     problems.append(f"layout: {what} {station.poi} {STOP_ERROR_M} m off: {error.reason}")
                     break
+    # The undock ends near the dock's POI, not on it: a drawn dock 0.42 m from a bench let the robot
+    # leave its POI but not a pose 1 cm beside it, where no turn was free.
+    for stop in _stops_near(dock):
+        for station in world.stations:
+            goal = world.pois[station.poi]
+            try:
+                paths.planner.plan((stop.x, stop.y, stop.yaw), (goal.x, goal.y, goal.yaw))
+            except PlanningError as error:
+                problems.append(f"layout: leaving the dock {STOP_ERROR_M} m off its POI: {error.reason}")
+                break
     return problems
 
 
