@@ -160,6 +160,8 @@ def test_a_joint_space_move_through_the_plate_in_the_nest_pushes_it_in_physics(
     before = sim.plate_bottom_pose(PLATE)
     run_way(sim, through.trajectories)
     assert plate_shift_m(sim, before) > 0.002
+    pushed = sim.plate_pushes.pushes  # the simulation says so, naming the link that pushed
+    assert pushed and pushed[0].plate == PLATE and pushed[0].link.startswith(f"gripper_{ARM}"), pushed
 
 
 def test_the_planned_way_reaches_the_nest_s_approach_and_touches_nothing(
@@ -179,7 +181,7 @@ def test_the_planned_way_reaches_the_nest_s_approach_and_touches_nothing(
         assert outcome.success, f"{way.name}: {outcome.error_code} {outcome.message}"
     reached = RobotKinematics().forward(sim.joint_positions(), f"gripper_{ARM}_grasping_frame")
     assert np.linalg.norm(reached[:3, 3] - targets[index][:3, 3]) < 0.005
-    assert plate_shift_m(sim, before) < 0.0005
+    assert plate_shift_m(sim, before) < 0.0005 and sim.plate_pushes.pushes == []
 
 
 def test_the_way_around_keeps_clear_of_the_station_and_the_robot_in_physics(

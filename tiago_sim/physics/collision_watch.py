@@ -89,6 +89,7 @@ class CollisionWatch:
         self.dock = scene.dock
         self.link_names = {index: name for name, index in robot.link_index.items()}
         self.touching: set[tuple[int, int]] = set()  # (link index, body) touching after the last step
+        self.points: tuple = ()  # the robot's contact points after the last step (pybullet's tuples)
         self.collisions: list[Collision] = []
         self.near_misses: dict[tuple[str, str], float] = {}  # (link, thing) -> closest approach (m)
         self.near_miss_period_s = NEAR_MISS_PERIOD_S if near_misses else math.inf
@@ -123,7 +124,8 @@ class CollisionWatch:
     def check(self, sim_time: float) -> list[Collision]:
         """The unintended contacts that started in the last step (each also kept in ``collisions``)."""
         deepest: dict[tuple[int, int], tuple[float, tuple[float, float, float]]] = {}
-        for point in p.getContactPoints(bodyA=self.robot.id, physicsClientId=self.client):
+        self.points = p.getContactPoints(bodyA=self.robot.id, physicsClientId=self.client)
+        for point in self.points:
             body, link, distance = point[2], point[3], point[8]
             if body not in self.things or (body == self.dock and self.link_names.get(link, "") in DOCK_LINKS):
                 continue

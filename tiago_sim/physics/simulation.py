@@ -34,6 +34,7 @@ from tiago_sim.physics.hotel_clamp import HotelClamp
 from tiago_sim.physics.motion import BUSY, CompletedMotion, FailedMotion, Motion
 from tiago_sim.physics.path_following import path_motion
 from tiago_sim.physics.plate_proximity import STEP_REVIEW_PERIOD, PlateProximity
+from tiago_sim.physics.plate_pushes import PlatePushWatch
 from tiago_sim.physics.plate_sensing import PlateSensing
 from tiago_sim.physics.robot_body import RobotBody
 from tiago_sim.physics.scene import build_scene
@@ -126,6 +127,7 @@ class Simulation:
         self.step_ledger = StepLedger()
         self.plate_sensing = PlateSensing(c, world, self.robot, self.scene, self.grippers)
         self.collision_watch = CollisionWatch(c, self.robot, self.scene)
+        self.plate_pushes = PlatePushWatch(c, self.collision_watch.link_names, self.scene.plates)
         self._reviewed_at = -1.0
         self._plate_within_range = True
         self._turning_loaded = False
@@ -164,11 +166,13 @@ class Simulation:
 
     def _stop_on_collision(self) -> None:
         """An unintended contact (collision_watch) stops the base at once and fails every running
-        motion, naming it."""
+        motion, naming it; a plate pushed without being held is logged (plate_pushes)."""
         for collision in self.collision_watch.check(self.sim_time):
             self.base.protective_stop()
             for motion in self.motions:
                 motion.finish(False, COLLISION, collision.text())
+        in_hand = {g.attached_id or g.slipped_id for g in self.grippers.values()}
+        self.plate_pushes.check(self.collision_watch.points, in_hand, self.sim_time)
 
     def _clamp_while_driving(self, base_driven: bool) -> None:
         """The hotel clamp closes when a base motion starts and opens once the base stands."""

@@ -120,6 +120,8 @@ def test_plate_goes_from_station_a_through_the_hotel_to_station_b():
         assert NestReading(Nest("station_b", 1), True, PLATE) in sim.nest_readings()
         # the plate settles 2 to 3 mm in the pads as the lift starts, by the arm's IK solution
         assert max(script.slips_m) < 0.004, script.slips_m
+        # grasps, releases and the hotel's pocket touch the plate, but push it nowhere
+        assert sim.plate_pushes.pushes == []
     finally:
         sim.close()
 
