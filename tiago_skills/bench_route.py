@@ -118,8 +118,8 @@ def nest_labware_boxes(
 ) -> list[Box]:
     """Labware standing in these nests (as large as `size`: length, width, height), placed where the
     marker is seen: a joint-space move to the approach above a nest swept a finger through the plate
-    it came for and pushed it out of its nest (random layout 181006), which the robot then found
-    missing as it came down to grasp it."""
+    it came for and pushed it out of its nest (random layout 181006), and the descent to grasp it
+    stopped short."""
     T_base_marker = upright_marker(T_base_marker_seen, station.T_table_marker())
     height = size[2]
     return [

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import logging
 import threading
+import time
 from queue import Queue
 from typing import Any
 
@@ -69,7 +70,10 @@ class PublishedValues:
             self._queues[name] = queue
 
     def wait(self) -> None:
-        """Return once every value published so far is what a new subscription receives."""
+        """Return once every value published so far is what a new subscription receives, or after
+        WAIT_S in all."""
+        deadline = time.monotonic() + WAIT_S
         for name, queue in self._queues.items():
-            if not queue.wait_taken(WAIT_S):
+            if not queue.wait_taken(max(deadline - time.monotonic(), 0.0)):
                 logger.warning("sila2 took longer than %.1f s to take up a new value of %s", WAIT_S, name)
+                return

@@ -138,7 +138,8 @@ def test_a_joint_space_move_through_the_plate_in_the_nest_pushes_it_in_physics(
 ) -> None:
     """The scenario of the labware boxes is real: a joint-space move to the approach above the plate
     it comes for, clear of the board and the bench but through the plate by the model, moves the
-    plate in physics (in random layout 181006 it left its nest, and the grasp found nothing)."""
+    plate in physics (in random layout 181006 it left its nest, and the descent to grasp it stopped
+    short)."""
     route = BenchRoute(behaviours(seed=0))
     start = sim.joint_positions()
     station = station_boxes(world.station("labeler"), seen_marker(world, sim))

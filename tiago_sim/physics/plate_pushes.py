@@ -2,7 +2,7 @@
 
 Why: touching plates is part of grasping and placing, so the collision watch does not count it. But
 a finger sweeping through a plate on its way to a nest pushed that plate out of its nest, and the
-run's log showed only the later step's failure (a descent that stopped short, a grasp on nothing).
+run's log showed only the later step's failure (the descent to grasp it stopped short).
 This watch reports a touch that moved an unheld plate by more than PUSH_M, once per touch: what the
 physics saw, for the log and the tests; it stops nothing (the robot's own sensors must notice).
 Lives on the sim thread; reads the contact points the collision watch fetched for the step.
