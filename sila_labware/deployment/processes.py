@@ -146,6 +146,7 @@ class ProcessGroup:
         self._prewarmed = prewarmed
         """Fork children from a process that imported them already (prewarmed.py), not spawn them."""
         self.children: list[Child] = []
+        self._starts: dict[str, int] = {}  # name -> how often it was started (restarts keep their logs)
 
     def start_python_module(self, name: str, module: str, arguments: Sequence[str]) -> Child:
         """Run `python -m module arguments...` with this interpreter; output goes to a log file."""
@@ -155,6 +156,10 @@ class ProcessGroup:
         if self._log_dir is not None:
             self._log_dir.mkdir(parents=True, exist_ok=True)
             log_path = self._log_dir / f"{name}.log"
+            runs = self._starts.get(name, 0)
+            if runs and log_path.exists():  # a restart: keep what the run before said, as name.N.log
+                log_path.replace(self._log_dir / f"{name}.{runs}.log")
+            self._starts[name] = runs + 1
             output = log_path.open("wb")
         else:
             output = output_file = tempfile.TemporaryFile(prefix=f"sila-labware-{name}-")

@@ -134,6 +134,9 @@ class RobotSideSupervisor:
         for child in self.children.children:
             if not child.running:
                 code = child.popen.returncode
+                tail = child.log_tail(lines=8)
+                if tail:  # why it ended: its own last words, before a restart starts it anew
+                    logger.error("%s ended (exit code %s); the end of its log:\n%s", child.name, code, tail)
                 return _Loss(child.name, code, f"{child.name} ended (exit code {code})")
         return None
 

@@ -93,6 +93,10 @@ def test_sim_node_killed_during_get_labware_then_next_transfer_succeeds(cell: Ce
     every_server_answers(cell)
     ready_after_s = wait_recovered(cell.deployment, restarts=1)
     assert ready_after_s < 60.0
+    # the killed run's log is kept beside the new one's
+    logs = cell.deployment.options.log_dir
+    assert "sim node ready" in (logs / "sim_node.1.log").read_text()
+    assert "sim node ready" in (logs / "sim_node.log").read_text()
     # A fresh simulation starts from the world file: the plate is back in station_a/1, and the
     # inventory says so from the new observations (not the lost pick's guess "aboard").
     assert cell.location(PLATE) == (False, "station_a", 1)
