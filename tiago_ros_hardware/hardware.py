@@ -44,6 +44,7 @@ from sensor_msgs.msg import LaserScan as LaserScanMsg
 from tf2_msgs.msg import TFMessage
 from trajectory_msgs.msg import JointTrajectoryPoint
 
+from robot_port.action_client import ThreadSafeActionClient
 from robot_port.execution import Execution
 from robot_port.hardware import HardwareUnavailable
 from robot_port.tiago_interfaces import (
@@ -137,7 +138,7 @@ class RosHardware:
             self.now()
 
     def _action(self, kind: Any, name: str) -> ActionClient:
-        self.actions[name] = ActionClient(self.node, kind, name, callback_group=self._group)
+        self.actions[name] = ThreadSafeActionClient(self.node, kind, name, callback_group=self._group)
         return self.actions[name]
 
     def _subscribe(self, kind: Any, topic: str, callback: Any, qos: QoSProfile) -> None:

@@ -41,13 +41,14 @@ from labware_interfaces.action import (
 )
 from labware_interfaces.msg import ErrorCodes, RobotState, StationStates
 from labware_interfaces.srv import DescribeWorkcell
-from rclpy.action import ActionClient, ActionServer, CancelResponse, GoalResponse
+from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.task import Future
 
 from labware_model.holders import GRIPPER, Location, Nest
 from labware_model.workcell import WorkcellDescription
+from robot_port.action_client import ThreadSafeActionClient
 from tiago_sim.sequencer.inventory_keeper import InventoryKeeper
 from tiago_sim.sequencer.plans import (
     RETREAT_AFTER,
@@ -86,7 +87,9 @@ class Sequencer:
         self.estimate_keys = tuple(str(key) for key in params["estimates_s"])
         for key, seconds in params["estimates_s"].items():
             node.declare_parameter(f"estimates_s.{key}", float(seconds))
-        self.clients = {name: ActionClient(node, kind, topic) for name, (kind, topic) in SUB_ACTIONS.items()}
+        self.clients = {
+            name: ThreadSafeActionClient(node, kind, topic) for name, (kind, topic) in SUB_ACTIONS.items()
+        }
         self.describe_client = node.create_client(DescribeWorkcell, "/describe_workcell")
         self.workcell: WorkcellDescription | None = None
         self.robot_state: RobotState | None = None

@@ -25,11 +25,11 @@ from builtin_interfaces.msg import Duration
 from control_msgs.action import FollowJointTrajectory
 from play_motion2_msgs.action import PlayMotion2
 from play_motion2_msgs.srv import IsMotionReady, ListMotions
-from rclpy.action import ActionClient
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 from trajectory_msgs.msg import JointTrajectoryPoint
 
+from robot_port.action_client import ThreadSafeActionClient
 from robot_port.tiago_interfaces import IS_MOTION_READY, LIST_MOTIONS, PLAY_MOTION2, controller_action
 from robot_port.types import JOINT_GROUPS
 from tiago_description import robot_model as rm
@@ -75,7 +75,9 @@ class PlayMotion2Server:
         self.played = 0
         group = ReentrantCallbackGroup()
         self.controllers = {
-            name: ActionClient(node, FollowJointTrajectory, controller_action(name), callback_group=group)
+            name: ThreadSafeActionClient(
+                node, FollowJointTrajectory, controller_action(name), callback_group=group
+            )
             for name in JOINT_GROUPS
         }
         self.server = cancellable_server(node, PlayMotion2, PLAY_MOTION2, self._execute, group)
