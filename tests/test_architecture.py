@@ -37,6 +37,8 @@ ALLOWED: dict[str, set[str]] = {
     "labware_model": set(),
     # the hardware port: types and a protocol, the seam between the skills and any robot
     "robot_port": set(),
+    # an rclpy action client safe from any thread: for every ROS client on the robot's side
+    "robot_port.action_client": set(),
     "tiago_description": set(),
     "lab_description": {"labware_model", "tiago_description"},
     # the robot's software: sees the robot only through the port, never the simulator
@@ -62,6 +64,7 @@ ALLOWED: dict[str, set[str]] = {
     "tiago_sim.sim_node": {
         "labware_model",
         "robot_port",
+        "robot_port.action_client",
         *DESCRIPTIONS,
         "tiago_sim.node_main",
         "tiago_sim.physics",
@@ -71,12 +74,13 @@ ALLOWED: dict[str, set[str]] = {
     # the task level: a ROS client of the robot's actions, as on the real robot
     "tiago_sim.sequencer": {
         "labware_model",
+        "robot_port.action_client",
         "tiago_sim.node_main",
         "tiago_sim.started_by",
         "lab_description",
     },
     # the hardware port over a TIAGo++'s own ROS 2 interfaces (a real robot, or the simulator's)
-    "tiago_ros_hardware": {"robot_port", "tiago_description"},
+    "tiago_ros_hardware": {"robot_port", "robot_port.action_client", "tiago_description"},
     # the start-up: the one unit that imports both the simulator and the skills
     "tiago_twin": {
         "robot_port",
@@ -134,6 +138,7 @@ PACKAGE_ROOTS = {top: set() for top in TOP_PACKAGES if top not in ALLOWED}
 FORBIDDEN_LIBRARIES: dict[str, set[str]] = {
     **{unit: {"sila2"} for unit in ALLOWED if unit.startswith("tiago_sim.")},  # first: the rows below win
     "robot_port": {"rclpy", "sila2", "pybullet", "cv2", "pinocchio", "yaml"},
+    "robot_port.action_client": {"sila2", "pybullet", "cv2", "pinocchio", "yaml"},
     "tiago_description": {"rclpy", "sila2", "pybullet", "cv2"},
     "lab_description": {"rclpy", "sila2", "pybullet", "cv2"},
     "tiago_skills": {"pybullet", "sila2"},
