@@ -51,10 +51,11 @@ NODE = {"num_cpus": 1, "object_store_memory": 80 * 1024 * 1024}
 
 
 @contextmanager
-def two_node_cluster(monkeypatch: pytest.MonkeyPatch) -> Iterator[tuple[Any, Any]]:
+def two_node_cluster(monkeypatch: pytest.MonkeyPatch, keep_logs_in: Path) -> Iterator[tuple[Any, Any]]:
     """A head and a second node, each with its own raylet; all of their processes stopped on exit.
     Ray's files (sockets, logs, and the "current cluster" note `ray.init("auto")` reads) stay in a
-    folder of the test's own: another run's `auto` never finds this cluster."""
+    folder of the test's own: another run's `auto` never finds this cluster. Its logs are copied to
+    `keep_logs_in` if the test fails inside."""
     from ray.cluster_utils import Cluster
 
     temp_dir = tempfile.mkdtemp(prefix="ray-", dir="/tmp")  # Ray's socket paths must stay short
@@ -68,6 +69,13 @@ def two_node_cluster(monkeypatch: pytest.MonkeyPatch) -> Iterator[tuple[Any, Any
         second = cluster.add_node(**NODE)
         cluster.wait_for_nodes()
         yield cluster, second
+    except BaseException:
+        # Ray's own logs go with its folder: keep them where pytest keeps the failed test's files
+        # (a cluster campaign hung once in an idle CI run, and nothing said where)
+        logs = Path(temp_dir, "ray", "session_latest", "logs")
+        if logs.is_dir():
+            shutil.copytree(logs, keep_logs_in / "ray-logs", dirs_exist_ok=True)
+        raise
     finally:
         cluster.shutdown()
         shutil.rmtree(temp_dir, ignore_errors=True)
@@ -85,11 +93,13 @@ def test_trials_on_two_nodes_end_as_their_seeds_jobs_run(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     campaign = ["--trials", "2", "--seed", str(SEED), *FAULTS, "--json"]
-    on_workers = json.loads(run_bench(*campaign, "--jobs", "2").stdout)
+    # each run takes under a minute: a bound of 120 s each keeps both inside pytest's 300 s, so a
+    # hang ends with what the bench printed
+    on_workers = json.loads(run_bench(*campaign, "--jobs", "2", timeout_s=120.0).stdout)
     report = tmp_path / "report"
-    with two_node_cluster(monkeypatch) as (cluster, second):
+    with two_node_cluster(monkeypatch, tmp_path) as (cluster, second):
         address, nodes = cluster.address, {short_id(cluster.head_node), short_id(second)}
-        done = run_bench(*campaign, "--cluster", address, "--report", str(report))
+        done = run_bench(*campaign, "--cluster", address, "--report", str(report), timeout_s=120.0)
     assert done.stdout.strip(), done.stderr[-3000:]
     summary = json.loads(done.stdout)
     assert summary["cluster"] == address and summary["trials"] == 2
@@ -132,7 +142,7 @@ def test_a_node_lost_mid_campaign_has_its_trial_run_again_on_the_head_marked_as_
     report = tmp_path / "report"
     stack = ["--insecure", "--no-discovery", "--port-base", str(free_port_base(2 * PORTS_PER_WORKER))]
     campaign = ["--trials", "2", "--seed", str(SEED), "--json", "--report", str(report)]
-    with two_node_cluster(monkeypatch) as (cluster, second):
+    with two_node_cluster(monkeypatch, tmp_path) as (cluster, second):
         raylet = second.all_processes["raylet"][0].process.pid
         command = [*CLI, "bench", *stack, *campaign, "--cluster", cluster.address]
         with subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as bench:
