@@ -21,7 +21,6 @@ from __future__ import annotations
 import fcntl
 import logging
 import os
-import random
 import re
 import time
 from pathlib import Path
@@ -31,7 +30,6 @@ log = logging.getLogger(__name__)
 SHM_DIR = Path("/dev/shm")
 PARTICIPANT_LOCK = re.compile(r"fastrtps_[0-9a-f]{16}_el")
 MIN_AGE_S = 60.0
-REPROBE_PAUSE_S = (0.01, 0.05)  # a probe holds a lock for microseconds; a participant for its life
 
 
 def _free(lock_file: Path) -> bool:
@@ -53,45 +51,27 @@ def _free(lock_file: Path) -> bool:
 
 def remove_dead_segments(directory: Path = SHM_DIR, min_age_s: float = MIN_AGE_S) -> int:
     """Remove every Fast DDS participant segment in `directory` that no living process holds and that is
-    older than `min_age_s`, with its lock file; returns how many files went.
-
-    A lock found held is probed once more after a pause of random length: another cleaner probing the
-    same lock at the same instant holds it for that instant, and each of two cleaners took the other's
-    probe for a living participant and left a dead segment behind (seen in an idle CI run)."""
+    older than `min_age_s`, with its lock file; returns how many files went."""
     if not directory.is_dir():
         return 0
-    oldest = time.time() - min_age_s
-    held = []
     removed = 0
+    oldest = time.time() - min_age_s
     for lock_file in directory.iterdir():
         if not PARTICIPANT_LOCK.fullmatch(lock_file.name):
             continue
         try:
-            if lock_file.stat().st_mtime > oldest:
+            if lock_file.stat().st_mtime > oldest or not _free(lock_file):
                 continue
         except OSError:  # gone meanwhile
             continue
-        if _free(lock_file):
-            removed += _remove(lock_file)
-        else:
-            held.append(lock_file)
-    if held:
-        time.sleep(random.uniform(*REPROBE_PAUSE_S))
-        removed += sum(_remove(lock_file) for lock_file in held if _free(lock_file))
+        for path in (lock_file.with_name(lock_file.name.removesuffix("_el")), lock_file):
+            try:
+                path.unlink()
+                removed += 1
+            except FileNotFoundError:
+                pass
+            except OSError as error:
+                log.debug("cannot remove %s: %s", path, error)
     if removed:
         log.info("removed %d shared-memory files of dead ROS processes from %s", removed, directory)
-    return removed
-
-
-def _remove(lock_file: Path) -> int:
-    """Remove a dead participant's segment and its lock file; how many of the two went."""
-    removed = 0
-    for path in (lock_file.with_name(lock_file.name.removesuffix("_el")), lock_file):
-        try:
-            path.unlink()
-            removed += 1
-        except FileNotFoundError:
-            pass
-        except OSError as error:
-            log.debug("cannot remove %s: %s", path, error)
     return removed

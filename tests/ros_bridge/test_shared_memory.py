@@ -10,16 +10,12 @@ must survive.
 
 from __future__ import annotations
 
-import fcntl
 import os
 import signal
 import subprocess
 import sys
-import threading
 import time
 from pathlib import Path
-
-import pytest
 
 from ros_bridge.shared_memory import PARTICIPANT_LOCK, SHM_DIR, remove_dead_segments
 
@@ -60,8 +56,8 @@ def test_a_killed_process_segments_go_and_a_living_ones_stay() -> None:
         _age(killed_locks | alive_locks)
         assert all((SHM_DIR / name).exists() for name in killed_locks)  # left behind by the kill
         # another test's deployment may clean at the same moment (every start does): the files must be
-        # gone, whoever removed them (a cleaner that finds a lock taken by another cleaner's probe
-        # probes again after a pause: the test below).
+        # gone, whoever removed them. A cleaner that finds a lock taken by another cleaner's probe
+        # leaves the file to that one, which unlinks it an instant later (seen once in a loaded CI run).
         remove_dead_segments()
         killed_files = [SHM_DIR / name for name in killed_locks]
         killed_files += [SHM_DIR / name.removesuffix("_el") for name in killed_locks]
@@ -89,22 +85,3 @@ def test_young_files_are_left_alone(tmp_path: Path) -> None:
     assert remove_dead_segments(tmp_path, min_age_s=0.0) == 2
     assert not lock.exists() and not segment.exists()
     assert port.exists()  # ports are shared and found again by number: never removed
-
-
-def test_a_lock_held_for_a_moment_by_another_cleaner_is_probed_again(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """Two cleaners probing one dead segment at once each hold its lock for an instant: the one that
-    finds it held looks again after a pause, and the segment goes."""
-    from ros_bridge import shared_memory
-
-    monkeypatch.setattr(shared_memory, "REPROBE_PAUSE_S", (0.5, 0.5))
-    lock = tmp_path / "fastrtps_00112233445566aa_el"
-    segment = tmp_path / "fastrtps_00112233445566aa"
-    lock.touch()
-    segment.write_bytes(b"\0" * 16)
-    probe = os.open(lock, os.O_RDWR)  # the other cleaner's probe, under way as ours starts
-    fcntl.flock(probe, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    threading.Timer(0.05, lambda: os.close(probe)).start()  # and over 50 ms later
-    assert remove_dead_segments(tmp_path, min_age_s=0.0) == 2
-    assert not lock.exists() and not segment.exists()
