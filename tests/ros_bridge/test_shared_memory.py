@@ -25,16 +25,28 @@ NODE = (
 )
 
 
+def _own_locks(pid: int) -> set[str]:
+    """The participant lock files process `pid` holds open (it keeps each open for its flock). Read from
+    the process itself: other tests' participants create theirs in the same folder at the same time."""
+    names = set()
+    for descriptor in Path(f"/proc/{pid}/fd").iterdir():
+        try:
+            target = Path(os.readlink(descriptor))
+        except OSError:  # closed meanwhile
+            continue
+        if target.parent == SHM_DIR and PARTICIPANT_LOCK.fullmatch(target.name):
+            names.add(target.name)
+    return names
+
+
 def _start_node() -> tuple[subprocess.Popen, set[str]]:
-    """A process with one ROS node, and the participant lock files that appeared while it started."""
-    before = set(os.listdir(SHM_DIR))
+    """A process with one ROS node, and the participant lock files it holds."""
     process = subprocess.Popen([sys.executable, "-c", NODE], stdout=subprocess.PIPE, text=True)
     assert process.stdout is not None and process.stdout.readline().strip() == "up"
     deadline = time.monotonic() + 30.0
     while time.monotonic() < deadline:
-        new = {name for name in set(os.listdir(SHM_DIR)) - before if PARTICIPANT_LOCK.fullmatch(name)}
-        if new:
-            return process, new
+        if own := _own_locks(process.pid):
+            return process, own
         time.sleep(0.1)
     raise AssertionError("the node opened no shared-memory segment")
 

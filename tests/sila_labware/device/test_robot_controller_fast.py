@@ -458,6 +458,7 @@ def test_the_station_refuses_and_settles_from_its_nest_sensor() -> None:
     station.prepare_for_output("rack", 2, 1)
     with pytest.raises(CommandSequenceError, match="still sees a plate after"):
         station.labware_removed("rack", 2)
-    threading.Timer(0.005, lambda: fake.set_nests((nest("rack", 2),))).start()
+    station.settle_timeout_s = 30.0  # a bound for a loaded machine: the wait ends when the sensor clears
+    threading.Timer(0.05, lambda: fake.set_nests((nest("rack", 2),))).start()
     station.labware_removed("rack", 2)  # the sensor clears while the station waits
     assert station.sequence.nest(2).phase.value == "idle"
