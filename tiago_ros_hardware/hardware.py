@@ -6,15 +6,12 @@ goals to the robot's controllers and to Nav2 (executions.GoalsExecution), or loo
 closes itself over the velocity command and odometry (executions.LoopExecution): the port's
 short straight drive has no standard interface on a robot.
 
-Where a TIAGo++ has no sensor for what the port offers, the adapter derives it: whether the
-gripper holds something comes from the fingers' joint positions after closing (they stop apart on a
-plate), not from a contact sensor. Docking is the lab's: Nav2's docking server (`dock_id` names the
-lab's dock; "" for its only one), and whether the robot is docked is the battery charging, as
-Nav2's charging dock reads it from `/battery_state`.
+Where a TIAGo++ has no sensor for what the port offers, the adapter derives it: holding, from the
+fingers' joint positions after closing (they stop apart on a plate). Docking is Nav2's docking
+server (`dock_id` names the lab's dock; "" for its only one); docked is the battery charging.
 
-The names and types are robot_port.tiago_interfaces'. Localisation's correction is the map -> odom
-transform on the robot's `/tf`, as AMCL sends it; the laser's mount is the robot's own, from the
-fixed frames robot_state_publisher latches on `/tf_static`.
+Names and types: robot_port.tiago_interfaces. Localisation's correction is AMCL's map -> odom on
+`/tf`; the laser's mount comes from the fixed frames robot_state_publisher latches on `/tf_static`.
 
 Threads: the node's callbacks on its executor's threads (the caller spins the node, with threads to
 spare for the goals' answers); every port method on any thread.
@@ -36,6 +33,7 @@ from nav_msgs.msg import Odometry
 from play_motion2_msgs.action import PlayMotion2
 from rclpy.action import ActionClient
 from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.event_handler import SubscriptionEventCallbacks
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
@@ -85,8 +83,7 @@ class RosHardware:
     """robot_port.RobotHardware on the robot's ROS 2 interfaces, through `node`."""
 
     def __init__(self, node: Node, dock_id: str = "", simulated_clock: bool = True) -> None:
-        """`simulated_clock`: the robot's time is a simulator's `/clock`; a robot's is the node's
-        own clock (wall time)."""
+        """`simulated_clock`: the robot's time is a simulator's `/clock`, not the node's wall clock."""
         self.node = node
         self.dock_id = dock_id
         self.simulated_clock = simulated_clock
@@ -233,10 +230,15 @@ class RosHardware:
     @contextmanager
     def _listening(self, *topics: tuple[str, Any, TopicHistory]) -> Iterator[None]:
         """Subscribed to `topics` for the block only: a simulator renders its camera and casts its
-        laser only while someone listens, and a robot's images are heavy on the network."""
+        laser only while someone listens, and a robot's images are heavy on the network. No QoS event
+        handlers: rclpy 7.1 adds them to a wait set unguarded, and one destroyed meanwhile ended an
+        executor thread (loaded CI: "destruction was requested", then no reading came)."""
         qos = QoSProfile(depth=2, reliability=ReliabilityPolicy.RELIABLE)
+        no_events = SubscriptionEventCallbacks(use_default_callbacks=False)
         subscriptions = [
-            self.node.create_subscription(kind, topic, history.add, qos, callback_group=self._group)
+            self.node.create_subscription(
+                kind, topic, history.add, qos, callback_group=self._group, event_callbacks=no_events
+            )
             for topic, kind, history in topics
         ]
         try:
