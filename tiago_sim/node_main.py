@@ -10,6 +10,7 @@ reserved that domain met two robots answering one action. Lives on: the process'
 
 from __future__ import annotations
 
+import faulthandler
 import logging
 import os
 import signal
@@ -24,6 +25,12 @@ from rclpy.signals import SignalHandlerOptions
 from tiago_sim.started_by import starter_pid
 
 log = logging.getLogger(__name__)
+
+
+def stacks_on_sigusr1() -> None:
+    """Write every thread's stack to stderr (the process's log) on SIGUSR1: a deployment whose robot
+    side does not come up asks for them (ProcessGroup.stacks). Called first in a process's main."""
+    faulthandler.register(signal.SIGUSR1, all_threads=True)
 
 
 def spin_node(

@@ -26,7 +26,7 @@ from rclpy.node import Node
 from lab_description.world import DEFAULT_WORLD, World, WorldError, load_world, with_stock_sensors
 from tiago_description.motion_library import DEFAULT_MOTIONS_FILE, load_motions
 from tiago_sim.measuring.run_recorder import RunRecorder
-from tiago_sim.node_main import spin_node
+from tiago_sim.node_main import spin_node, stacks_on_sigusr1
 from tiago_sim.sim_node.hardware import SimulatedHardware
 from tiago_sim.sim_node.navigation import Navigation
 from tiago_sim.sim_node.node import SimNode, make_simulation, robot_world
@@ -115,6 +115,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
 
 def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
+    stacks_on_sigusr1()
     logging.basicConfig(level=args.log_level, format="%(asctime)s %(levelname)s %(name)s: %(message)s")
     try:
         world = load_world(args.world)

@@ -198,6 +198,19 @@ class ProcessGroup:
                     + (f"; last lines of its log:\n{tail}" if tail else "")
                 )
 
+    def stacks(self, wait_s: float = 1.0, lines: int = 60) -> str:
+        """Have every running child write its threads' stacks into its log (SIGUSR1: the robot
+        side's processes register faulthandler for it) and return the ends of their logs: what a
+        child that did not come up in time was doing."""
+        running = [child for child in self.children if child.running]
+        for child in running:
+            try:
+                os.kill(child.pid, signal.SIGUSR1)
+            except ProcessLookupError:
+                pass
+        time.sleep(wait_s)
+        return "\n".join(f"--- {child.name} (pid {child.pid}):\n{child.log_tail(lines)}" for child in running)
+
     def terminate(self) -> None:
         """SIGTERM every child's process group and return at once (`stop` waits for them)."""
         for child in list(self.children):

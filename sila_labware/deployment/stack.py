@@ -223,6 +223,8 @@ class Deployment:
                 break
             except BridgeError as error:
                 if time.monotonic() > deadline:
+                    stacks = self.children.stacks()
+                    logger.warning("the robot side is not up; its processes' stacks:\n%s", stacks)
                     raise BridgeError(
                         f"the robot side did not come up within {self.options.ready_timeout_s:.0f} s: {error}"
                     ) from error

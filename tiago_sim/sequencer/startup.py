@@ -14,7 +14,7 @@ import yaml
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 
-from tiago_sim.node_main import spin_node
+from tiago_sim.node_main import spin_node, stacks_on_sigusr1
 from tiago_sim.sequencer.node import PARAMETERS, Sequencer, log
 
 DEFAULT_PARAMS = Path(__file__).with_name("sequencer.yaml")
@@ -53,6 +53,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument("--log-level", default="INFO")
     args = parser.parse_args(argv)
+    stacks_on_sigusr1()
     logging.basicConfig(level=args.log_level, format="%(asctime)s %(levelname)s %(name)s: %(message)s")
     params = load_params(args.params)
     params["label_checks"] = bool(params["label_checks"]) or args.label_checks

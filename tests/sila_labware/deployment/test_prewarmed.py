@@ -49,6 +49,20 @@ def test_stopping_the_group_ends_forked_children_by_signal_even_right_after_the_
     assert just_started.popen.returncode == -signal.SIGTERM, "SIGTERM must reach a child in its first moments"
 
 
+def test_a_child_that_is_not_up_shows_where_it_waits(tmp_path: Path) -> None:
+    """What a deployment logs when its robot side does not come up in time: each child's stacks."""
+    group = ProcessGroup(dict(os.environ), tmp_path, prewarmed=True)
+    group.start_python_module("waiting", PROBE, ["sleep"])
+    deadline = time.monotonic() + 30.0
+    while "SLEEPING" not in (tmp_path / "waiting.log").read_text():
+        assert time.monotonic() < deadline, "the forked child wrote nothing to its log"
+        time.sleep(0.05)
+    stacks = group.stacks(wait_s=2.0)
+    group.stop()
+    assert stacks.startswith("--- waiting (pid ")
+    assert 'child_probe.py", line' in stacks and "in main" in stacks, stacks
+
+
 def test_children_forked_one_after_the_other_are_independent(tmp_path: Path) -> None:
     group = ProcessGroup(dict(os.environ), tmp_path, prewarmed=True)
     first = group.start_python_module("first", PROBE, ["report", "0"])
