@@ -211,7 +211,8 @@ class Deployment:
 
     def _start_bridge(self, should_stop: Callable[[], bool]) -> None:
         join_ros_domain(self.domain_id)
-        self.runtime = self._new_runtime()
+        with interrupts_held():  # a ROS thread started must be registered, so that stop() ends it
+            self.runtime = self._new_runtime()
         self.link = RobotLink(self.runtime)
         deadline = time.monotonic() + self.options.ready_timeout_s
         while True:
