@@ -15,14 +15,12 @@ from collections.abc import Iterator
 from typing import Any
 
 import pytest
-import rclpy
 from control_msgs.action import FollowJointTrajectory
 from rclpy.action import ActionServer
-from rclpy.context import Context
-from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
 
 from robot_port.action_client import ThreadSafeActionClient
+from tests.helpers.spun_node import spun_node
 
 ACTION = "/thread_safe_action_client_probe"
 PAUSE_S = 0.3
@@ -56,22 +54,9 @@ def succeed(handle: Any) -> Any:
 
 @pytest.fixture
 def node() -> Iterator[Node]:
-    context = Context()
-    rclpy.init(context=context)
-    node = rclpy.create_node("thread_safe_action_client_probe", context=context)
-    server = ActionServer(node, FollowJointTrajectory, ACTION, execute_callback=succeed)
-    executor = MultiThreadedExecutor(num_threads=3, context=context)
-    executor.add_node(node)
-    spinner = threading.Thread(target=executor.spin, daemon=True)
-    spinner.start()
-    try:
+    with spun_node("thread_safe_action_client_probe") as (node, _ended):
+        ActionServer(node, FollowJointTrajectory, ACTION, execute_callback=succeed)  # torn down with it
         yield node
-    finally:
-        executor.shutdown()
-        spinner.join(timeout=10.0)
-        server.destroy()
-        node.destroy_node()
-        rclpy.shutdown(context=context)
 
 
 def test_a_goal_sent_from_another_thread_gets_its_answer_and_result(node: Node) -> None:

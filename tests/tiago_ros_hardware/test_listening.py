@@ -13,51 +13,28 @@ subscriptions, the same loop ended the executor within 60 rounds when this test 
 from __future__ import annotations
 
 import sys
-import threading
 from collections.abc import Iterator
 
 import pytest
-import rclpy
-from rclpy.context import Context
-from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
 
 from robot_port.tiago_interfaces import LASER
+from tests.helpers.spun_node import spun_node
 from tiago_ros_hardware.hardware import LaserScanMsg, RosHardware
 
 ROUNDS = 1500
 
 
 @pytest.fixture
-def spun_node() -> Iterator[tuple[Node, list[BaseException]]]:
-    context = Context()
-    rclpy.init(context=context)
-    node = rclpy.create_node("listening_probe", context=context)
-    executor = MultiThreadedExecutor(num_threads=4, context=context)
-    executor.add_node(node)
-    ended: list[BaseException] = []
-
-    def spin() -> None:
-        try:
-            executor.spin()
-        except BaseException as error:  # noqa: BLE001 - what ended the executor is the finding
-            ended.append(error)
-
-    spinner = threading.Thread(target=spin, daemon=True)
-    spinner.start()
-    try:
-        yield node, ended
-    finally:
-        executor.shutdown()
-        spinner.join(timeout=10.0)
-        node.destroy_node()
-        rclpy.shutdown(context=context)
+def spun() -> Iterator[tuple[Node, list[BaseException]]]:
+    with spun_node("listening_probe", threads=4) as node_and_end:
+        yield node_and_end
 
 
 def test_subscribing_and_unsubscribing_leaves_the_executor_spinning(
-    spun_node: tuple[Node, list[BaseException]],
+    spun: tuple[Node, list[BaseException]],
 ) -> None:
-    node, ended = spun_node
+    node, ended = spun
     hardware = RosHardware(node)  # its action clients are the waitables the wait set walks
     interval = sys.getswitchinterval()
     sys.setswitchinterval(1e-6)
