@@ -88,11 +88,17 @@ def test_an_unknown_joint_is_a_bad_goal(hardware: SimulatedHardware) -> None:
 def test_a_cancelled_trajectory_stands_before_it_ends(hardware: SimulatedHardware) -> None:
     torso = hardware.joint_positions()["torso_lift_joint"]
     target = 0.3 if torso < 0.15 else 0.0
-    lift = hardware.follow_joint_trajectory(JointTrajectory(({"torso_lift_joint": target},)))
-    hardware_time = hardware.now()
-    while hardware.now() < hardware_time + 0.5 and not lift.done:
-        lift.wait(0.01)
-    lift.cancel()
+    # At real time while the lift runs: unpaced, its 2 s and more of robot time passed in a fraction of
+    # a second, and a loaded machine's scheduler once let the lift end before the cancel went out.
+    hardware.sim_thread.realtime_factor_cap = 1.0
+    try:
+        lift = hardware.follow_joint_trajectory(JointTrajectory(({"torso_lift_joint": target},)))
+        hardware_time = hardware.now()
+        while hardware.now() < hardware_time + 0.5 and not lift.done:
+            lift.wait(0.01)
+        lift.cancel()
+    finally:
+        hardware.sim_thread.realtime_factor_cap = None
     assert not finished(lift).success and lift.error_code == "CANCELED"
     stopped_at = hardware.joint_positions()["torso_lift_joint"]
     assert abs(stopped_at - target) > 0.01
