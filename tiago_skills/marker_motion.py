@@ -25,6 +25,7 @@ from __future__ import annotations
 import logging
 import math
 import threading
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -55,7 +56,7 @@ from tiago_skills.joint_commands import move_joints
 from tiago_skills.perception.aruco import detect_marker
 from tiago_skills.perception.nest_occupancy import NestView, view_nest
 from tiago_skills.perception.site_frames import nest_in_base
-from tiago_skills.place_correction import place_shift
+from tiago_skills.place_correction import LOOK_AGAIN, place_shift
 
 log = logging.getLogger(__name__)
 
@@ -205,11 +206,41 @@ class MarkerMotionBehaviour:
         return view_nest(frame.depth, frame.intrinsics, T_site_optical, sizes, floor_m)
 
     def _centred_on_plate(
-        self, run: GoalRun, arm: str, T_base_site: np.ndarray, sighting: MarkerSighting
-    ) -> np.ndarray:
-        """The site moved by the shift that centres the held plate on it (as it is without a
-        measurement). Taken from where the tool stands now, above the nest after the approach."""
+        self,
+        run: GoalRun,
+        arm: str,
+        site_seen: Callable[[MarkerSighting], np.ndarray],
+        sighting: MarkerSighting,
+    ) -> tuple[np.ndarray, MarkerSighting]:
+        """The site (``site_seen`` of a marker sighting) moved by the shift that centres the held
+        plate on it (as it is without a measurement), and the sighting it was taken with. Taken from
+        where the tool stands now, above the nest after the approach. When the head has moved since
+        the marker's sighting or the plate is not seen whole (an end out of the image: random layout
+        191031), the head is aimed between the marker and the tool, and marker and plate are seen
+        again with that one gaze."""
+        T_base_site = site_seen(sighting)
+        shift, why = self._shift(run, arm, T_base_site, sighting)
+        if shift is None and why in LOOK_AGAIN:
+            joints = run.read(lambda hardware: dict(hardware.joint_positions()))
+            tool = self.behaviours.planning.tool_pose(arm, joints)[:3, 3]
+            between = (sighting.T_base_marker[:3, 3] + tool) / 2.0
+            log.info("looking again with marker and held plate in one view (%s)", why)
+            aim = within_head_limits(head_angles_towards(self.kinematics, joints, between))
+            run.follow(move_joints(aim), span=(0.0, 0.1))
+            try:
+                sighting = self.look(run, sighting.station)
+            except ActionAbort as lost:  # the place goes on as the first sighting shows it
+                if lost.code != ErrorCodes.MARKER_NOT_FOUND:
+                    raise
+                log.info("held plate not measured: %s from the new gaze", lost.message)
+                return T_base_site, sighting
+            T_base_site = site_seen(sighting)
+            shift, why = self._shift(run, arm, T_base_site, sighting)
+        return (T_base_site if shift is None else T_base_site @ tf.from_planar(*shift)), sighting
 
+    def _shift(
+        self, run: GoalRun, arm: str, T_base_site: np.ndarray, sighting: MarkerSighting
+    ) -> tuple[tf.Planar | None, str]:
         def capture() -> tuple:
             frame = run.read(lambda hardware: hardware.capture_head_camera())
             return frame.depth, frame.intrinsics, dict(frame.joints)
@@ -218,7 +249,7 @@ class MarkerMotionBehaviour:
             with self._lock:
                 return self.kinematics.forward(joints, frame)
 
-        shift = place_shift(
+        return place_shift(
             capture,
             forward,
             T_base_site,
@@ -228,9 +259,6 @@ class MarkerMotionBehaviour:
             self.world.labware_types.values(),
             self.grasp.grasp_height_m,
         )
-        if shift is None:
-            return T_base_site
-        return T_base_site @ tf.from_planar(*shift)
 
     def _in_the_column(self, run: GoalRun, arm: str, T_base_target: np.ndarray) -> bool:
         """Whether the tool is in the column above the nest (in the nest, or just out of it): from
@@ -287,10 +315,15 @@ class MarkerMotionBehaviour:
         # The marker's tilt comes from the level bench, not the image (perception.site_frames.upright_marker).
         # The height is the bench's (world file), not the sighting's (perception.site_frames.at_height).
         height = float((station.T_world_marker() @ T_marker_site)[2, 3])
-        T_base_site = nest_in_base(sighting.T_base_marker, station.T_table_marker(), T_marker_site, height)
+
+        def site_seen(seen: MarkerSighting) -> np.ndarray:
+            return nest_in_base(seen.T_base_marker, station.T_table_marker(), T_marker_site, height)
+
+        T_base_site = site_seen(sighting)
         releasing = goal.target == "site" and self.behaviours.holding.get(arm, False)
         if releasing:  # where the plate hangs, seen with the nest's marker: shift the tool to centre it
-            T_base_site = self._centred_on_plate(run, arm, T_base_site, sighting)
+            T_base_site, sighting = self._centred_on_plate(run, arm, site_seen, sighting)
+            marker_in_base = pose_msg(sighting.T_base_marker)
         T_base_grasp = T_base_site @ self.grasp.T_slot_grasp(approach=False, releasing=releasing)
         T_base_target = self.behaviours.grasp_twin(arm, T_base_grasp, seed)
         in_nest = goal.target == "site"  # slow only where the plate enters or leaves the nest

@@ -45,6 +45,11 @@ MAX_SHIFT_M = 0.015
 # Nor a larger turn: more than the hotel's pocket lets a carried plate turn (1 to 4 deg) and the
 # arm's heading error together.
 MAX_TURN_RAD = math.radians(8.0)
+# Why a shift is missing, when another look with the head aimed at marker and plate together may give it.
+HEAD_MOVED = "the head moved since the marker was seen"
+NOT_SEEN_WHOLE = "no plate type fits the pixels about the tool (an end hidden?)"
+NOT_BELIEVED = "the shift is larger than calibration and grasp errors make"
+LOOK_AGAIN = (HEAD_MOVED, NOT_SEEN_WHOLE)
 
 
 def head_moved(joints_then: dict[str, float], joints_now: dict[str, float]) -> bool:
@@ -73,10 +78,10 @@ def place_shift(
     sighting_joints: dict[str, float],
     plate_types: Iterable[LabwareType],
     plate_bottom_below_tool: float,
-) -> tf.Planar | None:
+) -> tuple[tf.Planar | None, str]:
     """The planar move (x, y, yaw) of the site frame that makes the tool's place pose, taken in the
-    moved frame, put the held plate centred and square on the nest; None when it cannot be measured
-    (the head moved, the plate not seen whole).
+    moved frame, put the held plate centred and square on the nest, and "" ; or None and why it cannot
+    be measured (HEAD_MOVED, NOT_SEEN_WHOLE, NOT_BELIEVED).
 
     The plate moves rigidly with the tool: if the tool went to the nominal pose G (heading 0 or pi, the
     twin it holds the plate with) the plate would land at G * inv(T) * P, T and P the tool's and the
@@ -89,8 +94,8 @@ def place_shift(
     depth, intrinsics, joints = capture()
     if head_moved(sighting_joints, joints):
         turned = {n: round(joints.get(n, 0.0) - sighting_joints.get(n, 0.0), 4) for n in HEAD_JOINTS}
-        log.info("held plate not measured: the head moved since the marker was seen (%s rad)", turned)
-        return None
+        log.info("held plate not measured: %s (%s rad)", HEAD_MOVED, turned)
+        return None, HEAD_MOVED
     T_site_base = tf.invert(T_base_site)
     points = site_points(depth, intrinsics, T_site_base @ forward(joints, camera_frame))
     T_site_tool = T_site_base @ forward(joints, f"gripper_{arm}_grasping_frame")
@@ -103,8 +108,8 @@ def place_shift(
         if sighting is not None:
             break
     if sighting is None:
-        log.info("held plate not measured: no plate type fits the pixels about the tool (an end hidden?)")
-        return None
+        log.info("held plate not measured: %s", NOT_SEEN_WHOLE)
+        return None, NOT_SEEN_WHOLE
     heading = tool_heading(T_site_tool)
     nominal = (0.0, 0.0, math.pi * round(heading / math.pi))
     in_hand = tf.compose_planar(tf.invert_planar((float(tool[0]), float(tool[1]), heading)), sighting.pose)
@@ -121,5 +126,5 @@ def place_shift(
             "move of %.1f mm, %.1f deg not believed: placing where the marker says",
             1000 * math.hypot(shift[0], shift[1]), math.degrees(shift[2]),
         )  # fmt: skip
-        return None
-    return shift
+        return None, NOT_BELIEVED
+    return shift, ""

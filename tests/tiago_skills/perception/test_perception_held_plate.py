@@ -19,7 +19,7 @@ from tiago_description.robot_model import PAD_WIDTH
 from tiago_sim.physics.camera import CameraIntrinsics, optical_frame_looking_at, render_rgbd
 from tiago_skills.behaviours import FLIP_ABOUT_APPROACH
 from tiago_skills.perception.held_plate import HeldPlateSighting, locate_held_plate, site_points
-from tiago_skills.place_correction import place_shift
+from tiago_skills.place_correction import HEAD_MOVED, place_shift
 
 PLATE = LabwareType("sbs", 0.12776, 0.08548, 0.01435, 0.35)
 GRASP_HEIGHT = 0.012  # grasping frame above the plate's bottom
@@ -167,7 +167,7 @@ def test_the_place_shift_is_free_of_the_camera_calibration_error(yaw_deg: float,
         "gripper_right_grasping_frame": T_base_tool,
     }
     joints = {"head_1_joint": 0.1, "head_2_joint": -0.9}
-    shift = place_shift(
+    shift, _why = place_shift(
         lambda: (depth, CameraIntrinsics(), joints),
         lambda _joints, frame: frames[frame],
         T_base_site_believed,
@@ -197,7 +197,7 @@ def test_no_shift_once_the_head_has_turned_but_one_while_it_settles(pan_then: fl
         "head_front_camera_rgb_optical_frame": T_world_optical,
         "gripper_right_grasping_frame": T_world_tool,
     }
-    shift = place_shift(
+    shift, why = place_shift(
         lambda: (depth, CameraIntrinsics(), {"head_1_joint": 0.1, "head_2_joint": -0.9}),
         lambda _joints, frame: frames[frame],
         T_WORLD_SITE,
@@ -208,6 +208,7 @@ def test_no_shift_once_the_head_has_turned_but_one_while_it_settles(pan_then: fl
         GRASP_HEIGHT,
     )
     assert (shift is not None) == measured
+    assert why == ("" if measured else HEAD_MOVED)
 
 
 @pytest.mark.parametrize("tool_off", [-0.012, -0.009, 0.009, 0.012])
