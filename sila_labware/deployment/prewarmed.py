@@ -42,6 +42,7 @@ PRELOADED_MODULES = ("tiago_twin.startup", "tiago_sim.physics.simulation", "tiag
 PR_SET_CHILD_SUBREAPER = 36
 PR_SET_NAME = 15
 MESSAGE_BYTES = 1 << 20
+ORPHANED = "not started: the process that asked for it ended before it was started"
 
 
 class ForkedChild:
@@ -86,7 +87,12 @@ class _ForkServer:
         self, module: str, arguments: Sequence[str], environment: Mapping[str, str], output: int
     ) -> ForkedChild:
         request = json.dumps(
-            {"module": module, "arguments": list(arguments), "environment": dict(environment)}
+            {
+                "module": module,
+                "arguments": list(arguments),
+                "environment": dict(environment),
+                "asker": os.getpid(),
+            }
         )
         with self._lock:
             connection = self._connection()
@@ -132,9 +138,15 @@ def fork_python_module(
 
 def _run_module(request: dict, output: int, intermediate: int) -> None:
     """In the forked child (its own session already): become what `python -m module arguments...`
-    would have been."""
+    would have been; or end at once if the asking process ended before the child was re-parented
+    to it (a Ray worker lost mid-start): re-parented to init, the node's check that its starter is
+    gone would compare against init and never fire (an orphaned sequencer outlived a CI run)."""
     while os.getppid() == intermediate:  # wait until re-parented to the asking process
         time.sleep(0.001)
+    parent = os.getppid()
+    if parent != request["asker"]:
+        os.write(output, f"{ORPHANED}: pid {request['asker']} (the parent is pid {parent})\n".encode())
+        raise SystemExit(1)
     name = request["module"].rsplit(".", 1)[-1].encode()[:15]
     ctypes.CDLL(None).prctl(PR_SET_NAME, ctypes.c_char_p(name), 0, 0, 0)
     os.environ.clear()

@@ -9,10 +9,11 @@ from __future__ import annotations
 import json
 import os
 import signal
+import socket
 import time
 from pathlib import Path
 
-from sila_labware.deployment.prewarmed import ForkedChild
+from sila_labware.deployment.prewarmed import MESSAGE_BYTES, ORPHANED, ForkedChild, _ForkServer
 from sila_labware.deployment.processes import ProcessGroup
 
 PROBE = "tests.helpers.child_probe"
@@ -71,3 +72,24 @@ def test_children_forked_one_after_the_other_are_independent(tmp_path: Path) -> 
     assert second.popen.wait(30.0) == 5
     assert first.popen.pid != second.popen.pid
     group.stop()
+
+
+def test_a_child_whose_asker_is_gone_ends_before_it_starts(tmp_path: Path) -> None:
+    """The asking process ended while its child was being re-parented to it (a Ray worker lost
+    mid-start): the child then finds another parent than the asker. Here the request names another
+    asker (init) than the process the child comes to; the child must not run its module."""
+    server = _ForkServer()
+    connection = server._connection()
+    request = {"module": PROBE, "arguments": ["report", "0"], "environment": dict(os.environ), "asker": 1}
+    log = tmp_path / "orphan.log"
+    with log.open("w") as output:
+        socket.send_fds(connection, [json.dumps(request).encode()], [output.fileno()])
+    child = ForkedChild(int(json.loads(connection.recv(MESSAGE_BYTES))["pid"]), [PROBE])
+    try:
+        assert child.wait(30.0) == 1
+    finally:
+        connection.close()
+        server._process.wait(30.0)
+    written = log.read_text()
+    assert ORPHANED in written and "pid 1 (the parent is pid " in written, written
+    assert '"argv"' not in written, "the module ran"
