@@ -262,6 +262,12 @@ def _median(values: list[float]) -> float:
     return float(statistics.median(values)) if values else 0.0
 
 
+NOT_JUDGED_UNPACED = (
+    "unpaced: SiLA remaining times are wall time, and the robot's clock races through motions and "
+    "crawls while the software computes; judge them with --pace 1"
+)
+
+
 def summarize(outcomes: list[TrialOutcome], levels: dict[str, float], seed: int) -> dict[str, Any]:
     """The success table and timings as one JSON-ready object."""
     successes = sum(outcome.success for outcome in outcomes)
@@ -343,8 +349,9 @@ def format_table(summary: dict[str, Any]) -> str:
         f"placement error of delivered plates: median {summary['placement_error_mm_median']:.1f} mm, "
         f"max {summary['placement_error_mm_max']:.1f} mm",
     ]
+    # unpaced, no wall-time estimate can hold (the summary says so)
     estimates = summary.get("remaining_time")
-    if estimates and estimates["steps"] and summary.get("pace"):  # unpaced, no wall-time estimate can hold
+    if estimates and estimates.get("steps") and summary.get("pace"):
         worst = min(estimates["by_step"].items(), key=lambda item: item[1])
         lines.append(
             f"remaining-time estimates within {100 * estimates['tolerance']:.0f} % of the step at each "

@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from sila_labware.benchmarks.campaign import (
+    NOT_JUDGED_UNPACED,
     PORTS_PER_WORKER,
     CampaignOptions,
     TrialOutcome,
@@ -266,6 +267,8 @@ def _run_and_report(args: argparse.Namespace, options: CampaignOptions) -> int:
     summary["jobs"] = options.jobs
     summary["cluster"] = args.cluster  # None: the trials ran on this machine's workers
     summary["pace"] = options.stack.pace  # None: unpaced, where the remaining times are not judged
+    if options.stack.pace is None:
+        summary["remaining_time"] = {"judged": False, "why": NOT_JUDGED_UNPACED}
     summary["random_layouts"] = options.layouts_dir is not None and options.layouts_flag == "--random-layouts"
     summary["random_obstacles"] = (
         options.layouts_dir is not None and options.layouts_flag == "--random-obstacles"

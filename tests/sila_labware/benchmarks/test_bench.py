@@ -146,6 +146,7 @@ def test_small_campaign_table_is_consistent_replays_and_reports(tmp_path: Path) 
         o["seed"] for o in summary["outcomes"] if not o["success"]
     }
     assert summary["sim_seconds_median"] > 0 and summary["realtime_factor"] > 0
+    assert summary["pace"] is None and summary["remaining_time"]["judged"] is False, "unpaced: not judged"
     # the default levels include the sensor and calibration errors of the real robot
     for flag in ("depth-noise-mm", "camera-mount-mm", "camera-mount-deg", "joint-offset-deg"):
         assert summary["levels"][flag] > 0, flag
