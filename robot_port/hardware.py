@@ -3,8 +3,9 @@
 What it holds is what a TIAGo++ offers its software, and no more: encoders, odometry, the base
 laser, the head camera, joint-trajectory controllers per group, the grippers, the base velocity
 command, and the navigation stack's goals (navigate to a pose, a short straight approach, dock,
-undock). The navigation stack (Nav2 and PAL's docking on a TIAGo++) is on the hardware's side of
-the port: its planner, localisation and docking are the vendor's, not our skills.
+undock) and plans (a path, without driving it). The navigation stack (Nav2 and PAL's docking on a
+TIAGo++) is on the hardware's side of the port: its planner, localisation and docking are the
+vendor's, not our skills.
 
 Commands return an ``Execution`` at once; readings answer at once. Implementations: the simulator
 (``tiago_sim.sim_node.hardware.SimulatedHardware``, in the same process) and, for a real robot,
@@ -70,6 +71,12 @@ class RobotHardware(Protocol):
 
     def navigate_to(self, goal: Pose2D, goal_name: str) -> Execution:
         """The navigation stack's goal: plan on the map, drive around what the laser sees."""
+
+    def plan_path(self, start: Pose2D, goal: Pose2D) -> tuple[Pose2D, ...]:
+        """The navigation stack's global plan from ``start`` to ``goal`` (map frame), made without
+        driving it: poses along the path, each with the heading the base drives on from there, the
+        goal last; empty when the planner finds none. Blocks while the planner plans (a second at
+        most on a TIAGo++; milliseconds in the simulator)."""
 
     def dock(self) -> Execution:
         """Onto the charging dock from its approach pose (the vendor's docking)."""

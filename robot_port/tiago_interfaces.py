@@ -36,6 +36,7 @@ CAMERA_INFO = "/head_front_camera/rgb/camera_info"
 CAMERA_DEPTH = "/head_front_camera/depth_registered/image_raw"
 JOINT_STATES = "/joint_states"
 NAVIGATE_TO_POSE = "/navigate_to_pose"
+COMPUTE_PATH_TO_POSE = "/compute_path_to_pose"
 DOCK_ROBOT = "/dock_robot"
 UNDOCK_ROBOT = "/undock_robot"
 BATTERY_STATE = "/battery_state"
@@ -70,6 +71,12 @@ TIAGO_INTERFACES: tuple[RosInterface, ...] = (
     ),
     RosInterface("/clock", "rosgraph_msgs/msg/Clock", "topic", "the simulator's time (a simulation only)"),
     RosInterface(NAVIGATE_TO_POSE, "nav2_msgs/action/NavigateToPose", "action", "Nav2's navigation goal"),
+    RosInterface(
+        COMPUTE_PATH_TO_POSE,
+        "nav2_msgs/action/ComputePathToPose",
+        "action",
+        "Nav2's planner: a path to a pose, not driven",
+    ),
     RosInterface(
         PLAY_MOTION2, "play_motion2_msgs/action/PlayMotion2", "action", "named motions (play_motion2)"
     ),

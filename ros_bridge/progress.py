@@ -62,15 +62,22 @@ class CommandProgress:
     def fraction(self) -> float:
         return self._fraction.fraction
 
-    def step(self, start: float, end: float, *, last: bool = True) -> Callable[[GoalProgress], None]:
+    def step(
+        self, start: float, end: float, *, last: bool = True, counts_rest: bool = False
+    ) -> Callable[[GoalProgress], None]:
         """A feedback listener for the goal that covers [start, end] of this command. The goal's
-        remaining time is the command's only for its `last` goal (the goals after an earlier one
-        have no estimate yet), and only where the robot side gave one (a remaining time of 0
-        before the goal is done means none)."""
+        remaining time is the command's for its `last` goal, or for an earlier one whose robot side
+        counts the goals after it too (`counts_rest`: an undock told the POI it drives to next),
+        and only where the robot side gave one (a remaining time of 0 before the goal is done means
+        none). An earlier goal's end leaves the command's remaining time unset until the next goal
+        reports, never 0."""
 
         def on_goal_progress(progress: GoalProgress) -> None:
             done = progress.progress >= 1.0
-            known = last and (progress.remaining_time_s > 0.0 or done)
+            if last:
+                known = progress.remaining_time_s > 0.0 or done
+            else:
+                known = counts_rest and progress.remaining_time_s > 0.0 and not done
             remaining = self._to_wall_s(progress.remaining_time_s) if known else None
             if remaining is not None and not done:
                 remaining = max(remaining, RUNNING_GOAL_LEAST_REMAINING_S)

@@ -180,8 +180,8 @@ class RobotLink:
     def dock(self, on_feedback: FeedbackListener | None = None) -> ActionGoal:
         return self._ros.dock.send(Dock.Goal(), on_feedback)
 
-    def undock(self, on_feedback: FeedbackListener | None = None) -> ActionGoal:
-        return self._ros.undock.send(Undock.Goal(), on_feedback)
+    def undock(self, on_feedback: FeedbackListener | None = None, then_poi: str = "") -> ActionGoal:
+        return self._ros.undock.send(Undock.Goal(then_poi=then_poi), on_feedback)
 
     def get_labware(
         self, handover: LabwareHandover, on_feedback: FeedbackListener | None = None

@@ -63,6 +63,7 @@ def test_the_port_offers_what_its_issue_names() -> None:
         "command_velocity",
         "drive_to",
         "navigate_to",
+        "plan_path",
         "dock",
         "undock",
     }

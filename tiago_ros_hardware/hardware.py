@@ -2,7 +2,8 @@
 
 Readings come from the robot's topics (topics.TopicHistory): a reading waits for a message stamped
 at or after the robot's time of the call, so it shows the robot as it stands then. Commands are
-goals to the robot's controllers and to Nav2 (executions.GoalsExecution), or loops the adapter
+goals to the robot's controllers and to Nav2 (executions.GoalsExecution; a plan waits for Nav2's
+planner, nav2_goals), or loops the adapter
 closes itself over the velocity command and odometry (executions.LoopExecution): the port's
 short straight drive has no standard interface on a robot.
 
@@ -27,8 +28,8 @@ from typing import Any
 
 import numpy as np
 from control_msgs.action import FollowJointTrajectory
-from geometry_msgs.msg import PoseStamped, Twist
-from nav2_msgs.action import DockRobot, NavigateToPose, UndockRobot
+from geometry_msgs.msg import Twist
+from nav2_msgs.action import ComputePathToPose, DockRobot, NavigateToPose, UndockRobot
 from nav_msgs.msg import Odometry
 from play_motion2_msgs.action import PlayMotion2
 from rclpy.action import ActionClient
@@ -51,6 +52,7 @@ from robot_port.tiago_interfaces import (
     CAMERA_IMAGE,
     CAMERA_INFO,
     CMD_VEL,
+    COMPUTE_PATH_TO_POSE,
     DOCK_ROBOT,
     JOINT_STATES,
     LASER,
@@ -70,6 +72,7 @@ from tiago_ros_hardware.base_loops import drive_loop, velocity_loop
 from tiago_ros_hardware.camera_messages import decoded, frame_pair
 from tiago_ros_hardware.executions import FailedExecution, GoalsExecution, LoopExecution
 from tiago_ros_hardware.frames import RobotFrames, yaw_of
+from tiago_ros_hardware.nav2_goals import map_pose, path_poses, path_request, result_of
 from tiago_ros_hardware.topics import TopicHistory, stamp_seconds
 from tiago_ros_hardware.trajectory_goals import controller_goals, duration_msg
 
@@ -77,6 +80,7 @@ READING_TIMEOUT_S = 30.0
 """Wall seconds a reading may wait for its topic before the robot counts as gone."""
 NAVIGATION_SPEED_MPS = 0.5  # for the time-left estimate of a navigation goal only
 DOCKING_S = 8.0  # for the time-left estimate of docking and undocking only
+PLANNING_TIMEOUT_S = 10.0  # wall seconds for Nav2's planner to answer
 
 
 class RosHardware:
@@ -117,6 +121,7 @@ class RosHardware:
             group: self._action(FollowJointTrajectory, controller_action(group)) for group in JOINT_GROUPS
         }
         self.navigation = self._action(NavigateToPose, NAVIGATE_TO_POSE)
+        self.planner = self._action(ComputePathToPose, COMPUTE_PATH_TO_POSE)
         self.docking = self._action(DockRobot, DOCK_ROBOT)
         self.undocking = self._action(UndockRobot, UNDOCK_ROBOT)
         self.named_motions = self._action(PlayMotion2, PLAY_MOTION2)
@@ -329,59 +334,42 @@ class RosHardware:
         )
 
     def navigate_to(self, goal: Pose2D, goal_name: str) -> Execution:
-        request = NavigateToPose.Goal(pose=PoseStamped())
-        request.pose.header.frame_id = "map"
-        request.pose.pose.position.x, request.pose.pose.position.y = float(goal[0]), float(goal[1])
-        request.pose.pose.orientation.z = math.sin(goal[2] / 2)
-        request.pose.pose.orientation.w = math.cos(goal[2] / 2)
         here = self.pose_estimate()
         seconds = math.dist(goal[:2], here[:2]) / NAVIGATION_SPEED_MPS + abs(
             math.remainder(goal[2] - here[2], math.tau)
         )
-        sent = [(NAVIGATE_TO_POSE, self.navigation, request)]
-        return self._claim(
-            {"base"},
-            lambda: GoalsExecution(
-                f"navigate to {goal_name}",
-                sent,
-                self._now_or_zero,
-                seconds,
-                "NAVIGATION_FAILED",
-                on_end=self._command_ended,
-            ),
-        )
+        request = NavigateToPose.Goal(pose=map_pose(goal))
+        sent = (NAVIGATE_TO_POSE, self.navigation, request)
+        return self._one_goal({"base"}, f"navigate to {goal_name}", sent, seconds, "NAVIGATION_FAILED")
+
+    def plan_path(self, start: Pose2D, goal: Pose2D) -> tuple[Pose2D, ...]:
+        result = result_of(self.planner, path_request(start, goal), PLANNING_TIMEOUT_S)
+        return () if result is None else path_poses(result.path)
 
     def dock(self) -> Execution:
         goal = DockRobot.Goal(use_dock_id=True, dock_id=self.dock_id, navigate_to_staging_pose=False)
-        return self._docking("dock", DOCK_ROBOT, self.docking, goal)
+        return self._one_goal({"base"}, "dock", (DOCK_ROBOT, self.docking, goal), DOCKING_S)
 
     def undock(self) -> Execution:
-        return self._docking("undock", UNDOCK_ROBOT, self.undocking, UndockRobot.Goal())
-
-    def _docking(self, name: str, action: str, client: ActionClient, goal: Any) -> Execution:
-        sent = [(action, client, goal)]
-        return self._claim(
-            {"base"},
-            lambda: GoalsExecution(
-                name, sent, self._now_or_zero, DOCKING_S, "MOTION_FAILED", on_end=self._command_ended
-            ),
-        )
+        sent = (UNDOCK_ROBOT, self.undocking, UndockRobot.Goal())
+        return self._one_goal({"base"}, "undock", sent, DOCKING_S)
 
     def play_motion(self, key: str, skip_planning: bool = False, expected_s: float = 5.0) -> Execution:
         """A named motion of the robot's play_motion2, the arms, torso and head claimed meanwhile;
         for a lab's tools, not the port's (the skills time their own keyframes). `skip_planning`
         False lets MoveIt plan the approach (PAL's advice); `expected_s`: the time-left estimate."""
         goal = PlayMotion2.Goal(motion_name=key, skip_planning=skip_planning)
-        sent = [(PLAY_MOTION2, self.named_motions, goal)]
+        groups = {"arm_left", "arm_right", "torso", "head"}
+        return self._one_goal(groups, f"motion {key}", (PLAY_MOTION2, self.named_motions, goal), expected_s)
+
+    def _one_goal(
+        self, groups: set[str], name: str, sent: tuple[str, ActionClient, Any], seconds: float, code: str = ""
+    ) -> Execution:
+        """One goal (action, client, goal) with `groups` claimed; `code` for a failure (MOTION_FAILED)."""
         return self._claim(
-            {"arm_left", "arm_right", "torso", "head"},
+            groups,
             lambda: GoalsExecution(
-                f"motion {key}",
-                sent,
-                self._now_or_zero,
-                expected_s,
-                "MOTION_FAILED",
-                on_end=self._command_ended,
+                name, [sent], self._now_or_zero, seconds, code or "MOTION_FAILED", on_end=self._command_ended
             ),
         )
 

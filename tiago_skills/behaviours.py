@@ -23,6 +23,7 @@ from tiago_description import robot_model as rm
 from tiago_description.motion_library import HOTEL_MOTIONS, MotionLibrary
 from tiago_description.transforms import make_transform
 from tiago_skills.arm_planning import ArmPlanning
+from tiago_skills.drive_estimate import planned_drive_s
 from tiago_skills.drive_posture import torso_for_drive
 from tiago_skills.goal_run import ActionAbort, GoalRun
 from tiago_skills.joint_commands import move_joints
@@ -113,12 +114,16 @@ class RobotBehaviours:
             )
 
     # -- base ----------------------------------------------------------------------------
-    def navigate(self, run: GoalRun, goal: Any) -> dict:
-        pose = self.poi_pose(goal.poi)
+    def known_poi(self, name: str) -> tuple[float, float, float]:
+        pose = self.poi_pose(name)
         if pose is None:
             raise ActionAbort(
-                ErrorCodes.UNKNOWN_POI, f"unknown POI {goal.poi!r}: known are {', '.join(self.poi_names())}"
+                ErrorCodes.UNKNOWN_POI, f"unknown POI {name!r}: known are {', '.join(self.poi_names())}"
             )
+        return pose
+
+    def navigate(self, run: GoalRun, goal: Any) -> dict:
+        pose = self.known_poi(goal.poi)
         if run.read(lambda hardware: hardware.is_docked()):
             raise ActionAbort(ErrorCodes.DOCKED, "the robot is docked: undock first")
         torso = torso_for_drive(run, self.motions, self.speed_scale(), goal.poi in self.station_pois)
@@ -151,10 +156,13 @@ class RobotBehaviours:
         run.follow(lambda hardware: hardware.dock(), span=(0.6 if pose is not None else 0.0, 1.0))
         return {}
 
-    def undock(self, run: GoalRun, _goal: Any) -> dict:
+    def undock(self, run: GoalRun, goal: Any) -> dict:
+        goal_pose = self.known_poi(goal.then_poi) if goal.then_poi else None  # refused before it moves
         if not run.read(lambda hardware: hardware.is_docked()):
             return {}
-        run.follow(lambda hardware: hardware.undock())
+        dock = self.poi_pose(self.dock_poi())  # where the undock ends
+        later_s = 0.0 if goal_pose is None else planned_drive_s(run, dock, goal_pose)
+        run.follow(lambda hardware: hardware.undock(), later_s=later_s)
         return {}
 
     # -- arm ----------------------------------------------------------------------------

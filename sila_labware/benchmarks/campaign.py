@@ -262,12 +262,6 @@ def _median(values: list[float]) -> float:
     return float(statistics.median(values)) if values else 0.0
 
 
-NOT_JUDGED_UNPACED = (
-    "unpaced: SiLA remaining times are wall time, and the robot's clock races through motions and "
-    "crawls while the software computes; judge them with --pace 1"
-)
-
-
 def summarize(outcomes: list[TrialOutcome], levels: dict[str, float], seed: int) -> dict[str, Any]:
     """The success table and timings as one JSON-ready object."""
     successes = sum(outcome.success for outcome in outcomes)

@@ -24,7 +24,6 @@ from pathlib import Path
 from typing import Any
 
 from sila_labware.benchmarks.campaign import (
-    NOT_JUDGED_UNPACED,
     PORTS_PER_WORKER,
     CampaignOptions,
     TrialOutcome,
@@ -42,6 +41,7 @@ from sila_labware.benchmarks.random_layouts import (
 )
 from sila_labware.benchmarks.ray_campaign import ClusterError, run_cluster_campaign
 from sila_labware.benchmarks.workers import run_parallel_campaign
+from sila_labware.client.remaining_time import NOT_JUDGED_UNPACED
 from sila_labware.deployment import json_outcome
 from sila_labware.deployment.json_outcome import JsonOutput, outcome_fields
 from sila_labware.deployment.stack import DeploymentOptions

@@ -92,6 +92,13 @@ def share_within(checks: Sequence[RemainingCheck]) -> float:
     return sum(check.within for check in judged) / len(judged) if judged else 0.0
 
 
+NOT_JUDGED_UNPACED = (
+    "unpaced: SiLA remaining times are wall time, and the robot's clock races through motions and "
+    "crawls while the software computes; judge them with --pace 1"
+)
+"""Why an unpaced campaign's summary judges no remaining time."""
+
+
 def summary(checks: Sequence[RemainingCheck]) -> dict[str, Any]:
     """The share of judged steps within the tolerance at every quarter, overall and per step name."""
     judged = [check for check in checks if check.judged]

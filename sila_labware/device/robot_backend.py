@@ -100,8 +100,10 @@ class RobotBackend(StationBackend, Protocol):
         """Drive onto the charging dock; the robot state then reads "docked"."""
         ...
 
-    def undock(self, on_feedback: FeedbackListener | None = None) -> ActionGoal:
-        """Leave the charging dock; the robot state then no longer reads "docked"."""
+    def undock(self, on_feedback: FeedbackListener | None = None, then_poi: str = "") -> ActionGoal:
+        """Leave the charging dock; the robot state then no longer reads "docked". `then_poi`: the
+        POI the caller drives to next, whose drive the goal's remaining time then counts too (an
+        unknown name ends the goal with UNKNOWN_POI before the base moves)."""
         ...
 
     def get_labware(

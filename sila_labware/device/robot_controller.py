@@ -258,9 +258,9 @@ class RobotController:
             status = self.link.robot_status()
             start = 0.0
             if status.docked:
-                outcome = self.goals.run(
-                    lambda: self.link.undock(progress.step(0.0, 0.2, last=False)), "Undock"
-                )
+                # the undock's remaining time counts the drive after it (the robot side plans it)
+                undocking = progress.step(0.0, 0.2, last=False, counts_rest=True)
+                outcome = self.goals.run(lambda: self.link.undock(undocking, then_poi=station.poi), "Undock")
                 if not outcome.success:
                     raise MotionFailed(outcome.error_code, _describe_failure("Undock", outcome))
                 start = 0.2

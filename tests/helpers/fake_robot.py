@@ -230,8 +230,8 @@ class FakeRobot:
     def dock(self, on_feedback: FeedbackListener | None = None) -> ActionGoal:
         return self._send("dock", None, on_feedback)
 
-    def undock(self, on_feedback: FeedbackListener | None = None) -> ActionGoal:
-        return self._send("undock", None, on_feedback)
+    def undock(self, on_feedback: FeedbackListener | None = None, then_poi: str = "") -> ActionGoal:
+        return self._send("undock", then_poi, on_feedback)
 
     def get_labware(
         self, handover: LabwareHandover, on_feedback: FeedbackListener | None = None

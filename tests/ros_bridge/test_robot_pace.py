@@ -81,3 +81,17 @@ def test_remaining_time_is_unset_where_there_is_no_estimate_and_never_zero_while
     drive(GoalProgress(0.5, "driving", 30.0))  # 30 robot seconds at 10x: 3 wall seconds
     progress.finish()
     assert reports == [(0.1, None), (0.2, None), (0.6, pytest.approx(3.0)), (1.0, 0.0)]
+
+
+def test_an_undock_that_counts_the_drive_after_it_reports_the_commands_remaining_time() -> None:
+    """Undock told the POI it drives to next (then_poi): its remaining time holds that drive; at its
+    end the command's is unset until the drive reports, never 0."""
+    reports: list[tuple[float, float | None]] = []
+    progress = CommandProgress(lambda fraction, remaining: reports.append((round(fraction, 6), remaining)))
+    undock = progress.step(0.0, 0.2, last=False, counts_rest=True)
+    drive = progress.step(0.2, 1.0)
+    undock(GoalProgress(0.5, "undocking", 14.0))  # 2 s of undock and 12 s of the drive after it
+    undock(GoalProgress(1.0, "done", 12.0))  # the undock's end: the next goal has not reported
+    undock(GoalProgress(1.0, "done", 0.0))  # its result
+    drive(GoalProgress(0.1, "driving", 11.0))
+    assert reports == [(0.1, 14.0), (0.2, None), (0.2, None), (0.28, 11.0)]

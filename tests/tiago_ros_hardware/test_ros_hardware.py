@@ -34,6 +34,8 @@ from tiago_description import transforms as tf
 from tiago_description.joint_limits import velocity_limits
 from tiago_description.motion_library import load_motions
 from tiago_ros_hardware.hardware import RosHardware
+from tiago_sim.navigation.planner import world_planner
+from tiago_sim.physics.path_following import plan_poses
 from tiago_sim.sim_node.named_motions import named_motions
 
 WAIT_S = 120.0
@@ -183,6 +185,26 @@ def test_the_base_undocks_drives_navigates_and_docks(robot: tuple[RosHardware, R
     docking = finished(hardware.dock())
     assert docking.success, docking.message
     assert hardware.is_docked()
+
+
+def test_a_plan_comes_from_nav2s_planner_without_driving(robot: tuple[RosHardware, RosCaller]) -> None:
+    """/compute_path_to_pose from a given start: the twin's planner's path, pose for pose, while
+    the base stays where it is; a goal inside a bench has none."""
+    hardware, _caller = robot
+    world = load_world(DEFAULT_WORLD)
+    dock, station = world.pois[world.dock_poi], world.stations[-1]
+    start, poi = (dock.x, dock.y, dock.yaw), world.pois[station.poi]
+    goal = (poi.x, poi.y, poi.yaw)
+    before = hardware.odometry()
+    path = hardware.plan_path(start, goal)
+    expected = plan_poses(world_planner(world).plan(start, goal), goal[2])
+    assert len(path) == len(expected)
+    for got, want in zip(path, expected, strict=True):
+        assert got[:2] == pytest.approx(want[:2], abs=1e-6)
+        assert abs(math.remainder(got[2] - want[2], math.tau)) < 1e-6
+    assert hardware.odometry() == pytest.approx(before, abs=1e-3)
+    table = station.T_world_table()[:3, 3]
+    assert hardware.plan_path(start, (float(table[0]), float(table[1]), 0.0)) == ()
 
 
 def test_the_pose_estimate_takes_localisations_correction_from_tf(

@@ -13,9 +13,9 @@ import math
 from collections.abc import Iterator, Mapping, Sequence
 
 from robot_port.trajectory_timing import RAMP_S, trapezoid_duration
+from tiago_description.drive_timing import rest_to_rest_s
 from tiago_description.robot_limits import active_limits
 from tiago_sim.physics.base_controller import wrap_angle
-from tiago_sim.physics.drive_timing import rest_to_rest_s
 
 FINGER_PREFIX = "gripper_"  # finger joints move with the gripper command, not on a trajectory
 SHORTEST_SEGMENT_M = 0.001  # a drive's segment shorter than this is no segment

@@ -16,10 +16,10 @@ import numpy as np
 
 from lab_description.world import Pose2D
 from tiago_description import robot_model as rm
+from tiago_description.drive_timing import BLEND_ANGLE, drive_duration_s
 from tiago_description.robot_limits import active_limits
 from tiago_description.transforms import compose_planar as compose
 from tiago_description.transforms import invert_planar as invert
-from tiago_sim.physics.drive_timing import BLEND_ANGLE, drive_duration_s
 from tiago_sim.physics.motion import CANCELED, Motion, SequenceMotion
 from tiago_sim.physics.robot_body import RobotBody
 

@@ -14,10 +14,10 @@ from __future__ import annotations
 
 import math
 
+from tiago_description.drive_timing import segment_durations_s
 from tiago_description.robot_limits import active_limits
 from tiago_sim.navigation.planner import Plan
 from tiago_sim.physics.base_controller import DiffDriveBase, DriveMotion, wrap_angle
-from tiago_sim.physics.drive_timing import drive_duration_s
 from tiago_sim.physics.motion import SequenceMotion
 
 TURN_WEIGHT_M = 0.1
@@ -28,6 +28,21 @@ def _bearing(a: tuple[float, float], b: tuple[float, float], reverse: bool) -> f
     """The heading the robot has while driving from a to b (backwards when `reverse`)."""
     heading = math.atan2(b[1] - a[1], b[0] - a[0])
     return wrap_angle(heading + math.pi) if reverse else heading
+
+
+def plan_poses(plan: Plan, goal_yaw: float) -> tuple[tuple[float, float, float], ...]:
+    """The plan as the navigation stack hands it out (the hardware port's `plan_path`): each waypoint
+    with the heading the base drives on from it (backwards on a reverse segment), the goal last."""
+    points, segments = plan.waypoints, len(plan.waypoints) - 1
+    poses = [
+        (*points[i], _bearing(points[i], points[i + 1], _reversed(plan, i, segments)))
+        for i in range(segments)
+    ]
+    return (*poses, (*points[-1], goal_yaw))
+
+
+def _reversed(plan: Plan, index: int, segments: int) -> bool:
+    return (index == 0 and plan.reverse_first) or (index == segments - 1 and plan.reverse_last)
 
 
 def path_motion(
@@ -43,20 +58,15 @@ def path_motion(
     speed = active_limits().linear_speed if speed is None else speed
     points = plan.waypoints
     segments = len(points) - 1
-    reverse = [
-        (index == 0 and plan.reverse_first) or (index == segments - 1 and plan.reverse_last)
-        for index in range(segments)
-    ]
+    reverse = [_reversed(plan, index, segments) for index in range(segments)]
     headings = [_bearing(points[i], points[i + 1], reverse[i]) for i in range(segments)]
     end_yaws = [*headings[1:], goal_yaw]
     _, _, yaw = base.estimate()
+    estimates_s = segment_durations_s(yaw, points, headings, goal_yaw, speed)
     stages = []
     for index in range(segments):
-        before = yaw if index == 0 else end_yaws[index - 1]
         length = math.dist(points[index], points[index + 1])
-        estimate_s = drive_duration_s(
-            wrap_angle(headings[index] - before), length, wrap_angle(end_yaws[index] - headings[index]), speed
-        )
+        estimate_s = estimates_s[index]
 
         def drive(index: int = index) -> DriveMotion:
             x, y = points[index + 1]

@@ -1,15 +1,16 @@
 """The base's ROS 2 interfaces a TIAGo++ offers: its velocity command, Nav2's navigation goal, and the
 docking a lab adds (Nav2's docking server, and the battery state its charging dock reads).
 
-Why: software written against a real robot drives the base by `/mobile_base_controller/cmd_vel_unstamped`
-(geometry_msgs/Twist, as twist_mux forwards it) and navigates by Nav2's `/navigate_to_pose`. The
-simulator offers both (tiago_twin --robot-interfaces): a velocity message drives the base for
+Why: software written against a real robot drives the base by
+`/mobile_base_controller/cmd_vel_unstamped` (geometry_msgs/Twist, as twist_mux forwards it), navigates
+by Nav2's `/navigate_to_pose` and asks its planner for a path by `/compute_path_to_pose`. The
+simulator offers all three (tiago_twin --robot-interfaces): a velocity message drives the base for
 CMD_VEL_TIMEOUT_S of robot time, as diff_drive_controller does, and a message before then renews the
-command without braking; a navigation goal goes to the navigation stand-in (navigation.Navigation),
-the simulator's Nav2. The one dock of the world file answers to any dock id of "" or its POI's
-name; docking drives onto it from where the base stands (or first navigates to its POI, the staging
-pose, when the goal asks), undocking drives off it. `/battery_state` says CHARGING while the
-charging contacts touch the dock, as Nav2's charging dock tells a docked robot.
+command without braking; a navigation goal and a plan go to the navigation stand-in
+(navigation.Navigation), the simulator's Nav2. The one dock of the world file answers to any dock
+id of "" or its POI's name; docking drives onto it from where the base stands (or first navigates to
+its POI, the staging pose, when the goal asks), undocking drives off it. `/battery_state` says
+CHARGING while the charging contacts touch the dock, as Nav2's charging dock tells a docked robot.
 
 Threads: subscription and goal callbacks on the node's executor threads; the base moves on the sim
 thread (jobs).
@@ -23,18 +24,25 @@ from typing import Any
 
 from builtin_interfaces.msg import Duration
 from geometry_msgs.msg import Twist
-from nav2_msgs.action import DockRobot, NavigateToPose, UndockRobot
+from nav2_msgs.action import ComputePathToPose, DockRobot, NavigateToPose, UndockRobot
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import BatteryState
 
 from lab_description.world import World
-from robot_port.tiago_interfaces import BATTERY_STATE, CMD_VEL, DOCK_ROBOT, NAVIGATE_TO_POSE, UNDOCK_ROBOT
+from robot_port.tiago_interfaces import (
+    BATTERY_STATE,
+    CMD_VEL,
+    COMPUTE_PATH_TO_POSE,
+    DOCK_ROBOT,
+    NAVIGATE_TO_POSE,
+    UNDOCK_ROBOT,
+)
 from tiago_sim.sim_node.action_server import cancellable_server
 from tiago_sim.sim_node.hardware import MotionExecution
 from tiago_sim.sim_node.localisation_topics import stamp_of
-from tiago_sim.sim_node.navigation import Navigation
+from tiago_sim.sim_node.navigation import Navigation, path_message
 from tiago_sim.sim_node.sim_thread import SimThread
 
 log = logging.getLogger(__name__)
@@ -90,10 +98,7 @@ class NavigateToPoseServer:
         self.server = cancellable_server(node, NavigateToPose, NAVIGATE_TO_POSE, self._execute)
 
     def _execute(self, handle: Any) -> NavigateToPose.Result:
-        pose = handle.request.pose.pose
-        q = pose.orientation
-        yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
-        goal = (float(pose.position.x), float(pose.position.y), yaw)
+        goal = pose2d_of(handle.request.pose.pose)
         started = self.sim_thread.sim_time
         execution = self.navigation.navigate(goal, f"({goal[0]:.2f}, {goal[1]:.2f})")
 
@@ -114,6 +119,36 @@ class NavigateToPoseServer:
             )
             handle.abort()
         return NavigateToPose.Result()
+
+
+class ComputePathToPoseServer:
+    """Nav2's /compute_path_to_pose on the navigation stand-in's planner: a path in the map frame
+    from `start` (or the pose estimate), without driving it. No path: an empty one, aborted (the
+    Humble action has no error code)."""
+
+    def __init__(self, node: Node, navigation: Navigation, sim_thread: SimThread) -> None:
+        self.navigation = navigation
+        self.sim_thread = sim_thread
+        self.server = cancellable_server(node, ComputePathToPose, COMPUTE_PATH_TO_POSE, self._execute)
+
+    def _execute(self, handle: Any) -> ComputePathToPose.Result:
+        request = handle.request
+        if request.use_start:
+            start = pose2d_of(request.start.pose)
+        else:
+            start = self.sim_thread.run(lambda sim: tuple(sim.pose_estimate()))
+        poses = self.navigation.plan_path(start, pose2d_of(request.goal.pose))
+        result = ComputePathToPose.Result()
+        result.path = path_message(poses, stamp_of(self.sim_thread.sim_time))
+        handle.succeed() if poses else handle.abort()
+        return result
+
+
+def pose2d_of(pose: Any) -> tuple[float, float, float]:
+    """(x, y, yaw) of a geometry_msgs/Pose on the floor."""
+    q = pose.orientation
+    yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+    return (float(pose.position.x), float(pose.position.y), yaw)
 
 
 def _duration(seconds: float) -> Duration:

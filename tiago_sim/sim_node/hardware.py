@@ -166,6 +166,9 @@ class SimulatedHardware:
     def navigate_to(self, goal: Pose2D, goal_name: str) -> Execution:
         return self.navigation.navigate(goal, goal_name)
 
+    def plan_path(self, start: Pose2D, goal: Pose2D) -> tuple[Pose2D, ...]:
+        return self.navigation.plan_path(start, goal)
+
     def dock(self) -> Execution:
         return self._start(lambda sim: sim.dock())
 

@@ -34,6 +34,7 @@ from tiago_sim.navigation.blockage import UnmappedObstacles, marks, still_there
 from tiago_sim.navigation.occupancy_map import OccupancyMap
 from tiago_sim.navigation.planner import GlobalPlanner, Plan, PlanningError, world_planner
 from tiago_sim.physics.guarded_path import PATH_BLOCKED, scan_in_map
+from tiago_sim.physics.path_following import plan_poses
 from tiago_sim.sim_node.publishers import stamp_of
 from tiago_sim.sim_node.sim_thread import SimThread
 
@@ -64,21 +65,13 @@ def grid_message(grid: OccupancyMap, stamp: Time) -> OccupancyGrid:
     return message
 
 
-def path_message(plan: Plan, goal_yaw: float, start_yaw: float, stamp: Time) -> Path:
-    """The plan as nav_msgs/Path: each waypoint with the heading the robot has leaving it (the goal
-    heading at the goal)."""
+def path_message(poses: tuple[tuple[float, float, float], ...], stamp: Time) -> Path:
+    """A plan's poses (`path_following.plan_poses`: each waypoint with the heading the robot drives
+    on from it, the goal heading at the goal) as nav_msgs/Path in the map frame."""
     message = Path()
     message.header.frame_id = MAP_FRAME
     message.header.stamp = stamp
-    points = plan.waypoints
-    for index, (x, y) in enumerate(points):
-        if index + 1 < len(points):
-            nx, ny = points[index + 1]
-            yaw = float(np.arctan2(ny - y, nx - x))
-        else:
-            yaw = goal_yaw
-        if index == 0 and plan.reverse_first:
-            yaw = start_yaw
+    for x, y, yaw in poses:
         pose = PoseStamped()
         pose.header = message.header
         pose.pose.position.x, pose.pose.position.y = float(x), float(y)
@@ -150,6 +143,18 @@ class Navigation:
         self.unmapped = UnmappedObstacles(self.static_map)
         self.last_plan: Plan | None = None
 
+    def plan_path(
+        self, start: tuple[float, float, float], goal: tuple[float, float, float]
+    ) -> tuple[tuple[float, float, float], ...]:
+        """The static map's plan from `start` to `goal`, as a navigation stack hands one out
+        (`path_following.plan_poses`); empty when there is none."""
+        try:
+            plan = self.planner.plan(start, goal)
+        except PlanningError as error:
+            log.info("no plan from %s to %s: %s", start, goal, error.reason)
+            return ()
+        return plan_poses(plan, goal[2])
+
     def navigate(self, goal: tuple[float, float, float], goal_name: str) -> NavigationGoal:
         """Start a goal: plan from the pose estimate to `goal` and drive there (see `_drive`)."""
         state = NavigationGoal("navigate")
@@ -205,7 +210,7 @@ class Navigation:
                 continue
             blocked_since = None
             self.last_plan = plan
-            self.plan_pub.publish(path_message(plan, goal[2], start[2], stamp_of(sim_thread.sim_time)))
+            self.plan_pub.publish(path_message(plan_poses(plan, goal[2]), stamp_of(sim_thread.sim_time)))
             motion = sim_thread.run(
                 lambda sim, plan=plan: sim.follow_path(plan, goal[2], watch=self.unmapped)
             )

@@ -4,9 +4,9 @@ Why: the skills reach the twin through the hardware port in-process, the fast wa
 software written against a real robot (and the port's ROS adapter) speaks the robot's interfaces
 instead (robot_port.tiago_interfaces). These are the ones the sensor topics do not already give:
 the controllers' actions (controllers), named motions (play_motion), the base's velocity input,
-Nav2's navigation goal and the docking a lab adds (base_interfaces), localisation's map -> odom on
-/tf and the robot model's fixed frames on /tf_static (tf_topic). Off by default: their endpoints
-cost discovery and CPU in every trial.
+Nav2's navigation goal and its planner, the docking a lab adds (base_interfaces), localisation's
+map -> odom on /tf and the robot model's fixed frames on /tf_static (tf_topic). Off by default:
+their endpoints cost discovery and CPU in every trial.
 """
 
 from __future__ import annotations
@@ -19,7 +19,12 @@ from lab_description.world import World
 from tiago_description.fixed_frames import fixed_frames
 from tiago_description.motion_library import MotionLibrary
 from tiago_description.robot_model import build_urdf
-from tiago_sim.sim_node.base_interfaces import BaseVelocityInput, DockingServers, NavigateToPoseServer
+from tiago_sim.sim_node.base_interfaces import (
+    BaseVelocityInput,
+    ComputePathToPoseServer,
+    DockingServers,
+    NavigateToPoseServer,
+)
 from tiago_sim.sim_node.controllers import TrajectoryControllers
 from tiago_sim.sim_node.localisation_topics import LocalisationTopics
 from tiago_sim.sim_node.named_motions import named_motions
@@ -50,6 +55,7 @@ class RobotInterfaces:
         static_transforms(node, fixed_frames(build_urdf()))
         self.velocity = BaseVelocityInput(node, sim_thread)
         self.navigation = NavigateToPoseServer(node, navigation, sim_thread)
+        self.planner = ComputePathToPoseServer(node, navigation, sim_thread)
         self.docking = DockingServers(node, world, navigation, sim_thread)
 
     def log_use(self) -> None:

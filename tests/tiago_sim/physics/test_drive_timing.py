@@ -12,9 +12,9 @@ from collections.abc import Iterator
 import pytest
 
 from lab_description.world import load_world
+from tiago_description.drive_timing import profile_s, rest_to_rest_s
 from tiago_sim.navigation.occupancy_map import build_map
 from tiago_sim.navigation.planner import GlobalPlanner
-from tiago_sim.physics.drive_timing import profile_s, rest_to_rest_s
 from tiago_sim.physics.simulation import Simulation
 
 

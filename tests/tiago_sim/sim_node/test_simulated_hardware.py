@@ -18,6 +18,7 @@ from lab_description.world import DEFAULT_WORLD, load_world
 from robot_port.hardware import RobotHardware
 from robot_port.types import JointTrajectory
 from tests.helpers.ros_processes import RosCaller
+from tiago_description.drive_timing import path_duration_s
 from tiago_sim.physics.simulation import Simulation
 from tiago_sim.sim_node.hardware import SimulatedHardware
 from tiago_sim.sim_node.navigation import Navigation
@@ -139,3 +140,25 @@ def test_navigation_reaches_a_poi_and_stops_on_a_cancel(hardware: SimulatedHardw
         going.wait(0.01)
     going.cancel()
     assert not finished(going).success and going.error_code == "CANCELED"
+
+
+def test_a_plan_ends_at_its_goal_and_its_timing_foretells_the_drive(hardware: SimulatedHardware) -> None:
+    """The navigation stack's plan, made without driving, timed by the drive's rule, is what the
+    drive along it then takes (robot time), within 10 %: the estimate an undock gives of the drive
+    after it. A goal inside a bench has no plan."""
+    world = load_world(DEFAULT_WORLD)
+    assert not hardware.is_docked()
+    station = world.stations[-1]
+    poi = world.pois[station.poi]
+    goal = (poi.x, poi.y, poi.yaw)
+    start = hardware.pose_estimate()
+    path = hardware.plan_path(start, goal)
+    assert len(path) >= 2 and path[-1] == pytest.approx(goal, abs=1e-6)
+    assert path[0][:2] == pytest.approx(start[:2], abs=1e-6)
+    planned_s = path_duration_s(start[2], path)
+    began = hardware.now()
+    assert finished(hardware.navigate_to(goal, station.poi)).success
+    took_s = hardware.now() - began
+    assert planned_s == pytest.approx(took_s, rel=0.10), (planned_s, took_s)
+    table = station.T_world_table()[:3, 3]
+    assert hardware.plan_path(hardware.pose_estimate(), (float(table[0]), float(table[1]), 0.0)) == ()

@@ -1,14 +1,16 @@
 """How long the base takes for a drive, as DriveMotion drives it: the estimates behind a drive's
-remaining time (navigation's feedback, the SiLA commands' remaining time).
+remaining time (navigation's feedback, the SiLA commands' remaining time), and a planned path's
+duration before it is driven (the skills' estimate of the drive after an undock).
 
 Why apart from the controller: the timing is plain arithmetic over TIAGo's limits and the control
 law's shape (speeding up at the base's limit, braking at 80 % of it, the turn handing over to the
-drive at BLEND_ANGLE), shared by path following, docking and the time budget's minima.
+drive at BLEND_ANGLE), shared by path following, docking, the time budget's minima and the skills.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 from tiago_description.robot_limits import active_limits
 
@@ -91,3 +93,53 @@ def drive_duration_s(
     )
     aligning = _turn_s(align_rad, 0.0 if moving or turn_rad else angular_speed)
     return turning + driving + aligning + SETTLE_S
+
+
+STRAIGHT_RAD = 0.05
+"""Poses of a planned path whose headings differ by less than this belong to one straight run (a
+planner's dense path: Nav2's poses lie a map cell apart)."""
+
+
+def _wrap(angle: float) -> float:
+    return (angle + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def segment_durations_s(
+    start_yaw: float,
+    points: Sequence[tuple[float, float]],
+    headings: Sequence[float],
+    goal_yaw: float,
+    speed: float,
+) -> list[float]:
+    """How long each straight segment of a path takes, driven rest to rest (DriveMotion): the first
+    turns from `start_yaw` to its heading, each ends turned to the next one's heading, the last to
+    `goal_yaw`. `headings[i]` is the base's heading while it drives from points[i] to points[i+1]
+    (backwards on a reverse segment)."""
+    end_yaws = [*headings[1:], goal_yaw]
+    durations, before = [], start_yaw
+    for index, heading in enumerate(headings):
+        length = math.dist(points[index], points[index + 1])
+        durations.append(
+            drive_duration_s(_wrap(heading - before), length, _wrap(end_yaws[index] - heading), speed)
+        )
+        before = end_yaws[index]
+    return durations
+
+
+def path_duration_s(
+    start_yaw: float, path: Sequence[tuple[float, float, float]], speed: float | None = None
+) -> float:
+    """How long the base takes along a planned path, as the drive makes it: `path` holds poses
+    (x, y, the heading the base has driving on from there), the last one the goal with its heading;
+    poses that continue a straight run (STRAIGHT_RAD) are one segment. `speed`: the base's limit
+    when None."""
+    if len(path) < 2:
+        return 0.0
+    points, headings = [path[0][:2]], [path[0][2]]
+    for pose in path[1:-1]:
+        if abs(_wrap(pose[2] - headings[-1])) >= STRAIGHT_RAD:
+            points.append(pose[:2])
+            headings.append(pose[2])
+    points.append(path[-1][:2])
+    limit = active_limits().linear_speed if speed is None else speed
+    return sum(segment_durations_s(start_yaw, points, headings, path[-1][2], limit))
