@@ -93,6 +93,27 @@ def pose_msg(transform: np.ndarray) -> Pose:
     return pose
 
 
+def reachable_place(
+    behaviours: RobotBehaviours,
+    arm: str,
+    T_base_measured: np.ndarray,
+    T_base_as_marked: np.ndarray | None,
+    seed: dict[str, float],
+) -> tuple[np.ndarray, bool]:
+    """The grasp pose (the twin the arm holds the plate with) for the measured place, or, where the
+        arm cannot reach that, for the place the marker alone gives (True: fell back). Why: a measured
+        place millimetres beyond the reach of an arm working at its edge failed a transfer (IK_FAILED)
+        whose place as marked, which the approach had reached, delivers. IK_FAILED if neither is reached
+    (`T_base_as_marked` None: no other place)."""
+    try:
+        return behaviours.grasp_twin(arm, T_base_measured, seed), False
+    except ActionAbort:
+        if T_base_as_marked is None:
+            raise
+    log.warning("the measured place is out of the %s arm's reach: placing where the marker says", arm)
+    return behaviours.grasp_twin(arm, T_base_as_marked, seed), True
+
+
 class MarkerMotionBehaviour:
     """Execute function of /marker_motion."""
 
@@ -321,11 +342,14 @@ class MarkerMotionBehaviour:
 
         T_base_site = site_seen(sighting)
         releasing = goal.target == "site" and self.behaviours.holding.get(arm, False)
+        as_marked = T_base_site
         if releasing:  # where the plate hangs, seen with the nest's marker: shift the tool to centre it
             T_base_site, sighting = self._centred_on_plate(run, arm, site_seen, sighting)
             marker_in_base = pose_msg(sighting.T_base_marker)
-        T_base_grasp = T_base_site @ self.grasp.T_slot_grasp(approach=False, releasing=releasing)
-        T_base_target = self.behaviours.grasp_twin(arm, T_base_grasp, seed)
+        grasp_in_site = self.grasp.T_slot_grasp(approach=False, releasing=releasing)
+        other = None if T_base_site is as_marked else as_marked @ grasp_in_site
+        measured = T_base_site @ grasp_in_site
+        T_base_target, _fell_back = reachable_place(self.behaviours, arm, measured, other, seed)
         in_nest = goal.target == "site"  # slow only where the plate enters or leaves the nest
         speed = TOOL_SPEED_INTO_POCKET if in_nest else TOOL_SPEED_FREE
         # From the hotel (PutLabware): straight up to the carry height, then straight to the bench.
