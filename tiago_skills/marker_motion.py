@@ -101,10 +101,10 @@ def reachable_place(
     seed: dict[str, float],
 ) -> tuple[np.ndarray, bool]:
     """The grasp pose (the twin the arm holds the plate with) for the measured place, or, where the
-        arm cannot reach that, for the place the marker alone gives (True: fell back). Why: a measured
-        place millimetres beyond the reach of an arm working at its edge failed a transfer (IK_FAILED)
-        whose place as marked, which the approach had reached, delivers. IK_FAILED if neither is reached
-    (`T_base_as_marked` None: no other place)."""
+    arm cannot reach that, for the place the marker alone gives (True: fell back); IK_FAILED if
+    neither is reached (`T_base_as_marked` None: there is no other place). Why: a measured place
+    millimetres beyond the reach of an arm working at its edge failed a transfer (IK_FAILED) whose
+    place as marked, which the approach had reached, delivers."""
     try:
         return behaviours.grasp_twin(arm, T_base_measured, seed), False
     except ActionAbort:
