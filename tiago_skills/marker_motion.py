@@ -33,6 +33,7 @@ import numpy as np
 from geometry_msgs.msg import Pose
 from labware_interfaces.msg import ErrorCodes
 
+from lab_description.station_placement import approach_heights
 from lab_description.world import World
 from tiago_description import transforms as tf
 from tiago_description.kinematics import RobotKinematics, head_angles_towards, within_head_limits
@@ -57,6 +58,7 @@ from tiago_skills.perception.aruco import detect_marker
 from tiago_skills.perception.nest_occupancy import NestView, view_nest
 from tiago_skills.perception.site_frames import nest_in_base
 from tiago_skills.place_correction import LOOK_AGAIN, place_shift
+from tiago_skills.reachable import first_reachable
 
 log = logging.getLogger(__name__)
 
@@ -91,27 +93,6 @@ def pose_msg(transform: np.ndarray) -> Pose:
     pose.position.x, pose.position.y, pose.position.z = (float(v) for v in position)
     pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w = (float(v) for v in quat)
     return pose
-
-
-def reachable_place(
-    behaviours: RobotBehaviours,
-    arm: str,
-    T_base_measured: np.ndarray,
-    T_base_as_marked: np.ndarray | None,
-    seed: dict[str, float],
-) -> tuple[np.ndarray, bool]:
-    """The grasp pose (the twin the arm holds the plate with) for the measured place, or, where the
-    arm cannot reach that, for the place the marker alone gives (True: fell back); IK_FAILED if
-    neither is reached (`T_base_as_marked` None: there is no other place). Why: a measured place
-    millimetres beyond the reach of an arm working at its edge failed a transfer (IK_FAILED) whose
-    place as marked, which the approach had reached, delivers."""
-    try:
-        return behaviours.grasp_twin(arm, T_base_measured, seed), False
-    except ActionAbort:
-        if T_base_as_marked is None:
-            raise
-    log.warning("the measured place is out of the %s arm's reach: placing where the marker says", arm)
-    return behaviours.grasp_twin(arm, T_base_as_marked, seed), True
 
 
 class MarkerMotionBehaviour:
@@ -281,6 +262,13 @@ class MarkerMotionBehaviour:
             self.grasp.grasp_height_m,
         )
 
+    def _approach_heights(self, station: Any) -> list[float]:
+        """The station's approach height, then the lower ones down to the least that keeps a held plate
+        over a neighbour's tallest labware (station_placement.approach_heights), highest first."""
+        tallest = max((t.height for t in self.world.labware_types.values()), default=0.0)
+        lower = [h for h in approach_heights(tallest) if h < station.approach_height - 1e-9]
+        return [station.approach_height, *lower]
+
     def _in_the_column(self, run: GoalRun, arm: str, T_base_target: np.ndarray) -> bool:
         """Whether the tool is in the column above the nest (in the nest, or just out of it): from
         there it only rises or sinks straight; from anywhere else it comes by the first clear way
@@ -323,11 +311,6 @@ class MarkerMotionBehaviour:
         if sighting is None:
             sighting = self.look(run, station.name)
         marker_in_base = pose_msg(sighting.T_base_marker)
-        T_marker_site = (
-            station.T_marker_site(sub_position)
-            if goal.target == "site"
-            else station.T_marker_site_approach(sub_position)
-        )
         seed = run.read(lambda hardware: dict(hardware.joint_positions()))
         # Nests sit on level benches and the base stands on the floor, so the nest frame is levelled:
         # a marker glued 1.4 deg askew in its plane tilted the perceived nest by as much, and together
@@ -335,21 +318,35 @@ class MarkerMotionBehaviour:
         # Heading and position still come from the marker.
         # The marker's tilt comes from the level bench, not the image (perception.site_frames.upright_marker).
         # The height is the bench's (world file), not the sighting's (perception.site_frames.at_height).
-        height = float((station.T_world_marker() @ T_marker_site)[2, 3])
 
-        def site_seen(seen: MarkerSighting) -> np.ndarray:
+        def site_seen(seen: MarkerSighting, above_m: float = 0.0) -> np.ndarray:
+            """The nest (or the point `above_m` over it) in base_footprint, from a marker sighting."""
+            T_marker_site = station.T_marker_site(sub_position) @ tf.make_transform((0.0, 0.0, above_m))
+            height = float((station.T_world_marker() @ T_marker_site)[2, 3])
             return nest_in_base(seen.T_base_marker, station.T_table_marker(), T_marker_site, height)
 
-        T_base_site = site_seen(sighting)
         releasing = goal.target == "site" and self.behaviours.holding.get(arm, False)
-        as_marked = T_base_site
-        if releasing:  # where the plate hangs, seen with the nest's marker: shift the tool to centre it
-            T_base_site, sighting = self._centred_on_plate(run, arm, site_seen, sighting)
-            marker_in_base = pose_msg(sighting.T_base_marker)
         grasp_in_site = self.grasp.T_slot_grasp(approach=False, releasing=releasing)
-        other = None if T_base_site is as_marked else as_marked @ grasp_in_site
-        measured = T_base_site @ grasp_in_site
-        T_base_target, _fell_back = reachable_place(self.behaviours, arm, measured, other, seed)
+        if goal.target == "site":
+            as_marked = site_seen(sighting)
+            places = [as_marked]
+            if releasing:  # where the plate hangs, seen with the nest's marker: shift the tool to centre it
+                measured, sighting = self._centred_on_plate(run, arm, site_seen, sighting)
+                marker_in_base = pose_msg(sighting.T_base_marker)
+                places = [measured] if measured is as_marked else [measured, as_marked]
+            grasps = [place @ grasp_in_site for place in places]
+            T_base_target, index = first_reachable(self.behaviours, arm, grasps, seed)
+            if index:
+                log.warning("the measured place is out of the %s arm's reach: placing as marked", arm)
+        else:
+            heights = self._approach_heights(station)
+            grasps = [site_seen(sighting, height) @ grasp_in_site for height in heights]
+            T_base_target, index = first_reachable(self.behaviours, arm, grasps, seed)
+            if index:
+                log.warning(
+                    "the %s arm does not reach %.0f mm above nest %d of %s: approaching at %.0f mm",
+                    arm, 1000 * heights[0], sub_position, station.name, 1000 * heights[index],
+                )  # fmt: skip
         in_nest = goal.target == "site"  # slow only where the plate enters or leaves the nest
         speed = TOOL_SPEED_INTO_POCKET if in_nest else TOOL_SPEED_FREE
         # From the hotel (PutLabware): straight up to the carry height, then straight to the bench.

@@ -5,7 +5,7 @@ head image's edge at the gaze that had seen the marker, the place correction mea
 the plate went down uncorrected onto the nest's brackets (PLACE_FAILED). The skills now aim the head
 between the marker and the tool, see both again with that one gaze, and place the plate measured.
 
-(What the skills do when a measured place lies beyond the arm's reach: test_reachable_place.py.)
+(What the skills do when a measured place lies beyond the arm's reach: test_reachable.py.)
 
 The fixture is that layout; the replay draws the same disturbances. The whole chain runs as a user
 runs it (bench over SiLA, the bridge, ROS, the skills, PyBullet).
