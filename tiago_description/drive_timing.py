@@ -13,6 +13,7 @@ import math
 from collections.abc import Sequence
 
 from tiago_description.robot_limits import active_limits
+from tiago_description.transforms import wrap_angle
 
 BLEND_ANGLE = 0.3  # rad: the drive starts once the heading is this close; the heading loop finishes the turn
 
@@ -100,10 +101,6 @@ STRAIGHT_RAD = 0.05
 planner's dense path: Nav2's poses lie a map cell apart)."""
 
 
-def _wrap(angle: float) -> float:
-    return (angle + math.pi) % (2.0 * math.pi) - math.pi
-
-
 def segment_durations_s(
     start_yaw: float,
     points: Sequence[tuple[float, float]],
@@ -119,9 +116,8 @@ def segment_durations_s(
     durations, before = [], start_yaw
     for index, heading in enumerate(headings):
         length = math.dist(points[index], points[index + 1])
-        durations.append(
-            drive_duration_s(_wrap(heading - before), length, _wrap(end_yaws[index] - heading), speed)
-        )
+        turn, align = wrap_angle(heading - before), wrap_angle(end_yaws[index] - heading)
+        durations.append(drive_duration_s(turn, length, align, speed))
         before = end_yaws[index]
     return durations
 
@@ -137,7 +133,7 @@ def path_duration_s(
         return 0.0
     points, headings = [path[0][:2]], [path[0][2]]
     for pose in path[1:-1]:
-        if abs(_wrap(pose[2] - headings[-1])) >= STRAIGHT_RAD:
+        if abs(wrap_angle(pose[2] - headings[-1])) >= STRAIGHT_RAD:
             points.append(pose[:2])
             headings.append(pose[2])
     points.append(path[-1][:2])

@@ -363,13 +363,18 @@ class RosHardware:
         return self._one_goal(groups, f"motion {key}", (PLAY_MOTION2, self.named_motions, goal), expected_s)
 
     def _one_goal(
-        self, groups: set[str], name: str, sent: tuple[str, ActionClient, Any], seconds: float, code: str = ""
+        self,
+        groups: set[str],
+        name: str,
+        sent: tuple[str, ActionClient, Any],
+        seconds: float,
+        code: str = "MOTION_FAILED",
     ) -> Execution:
-        """One goal (action, client, goal) with `groups` claimed; `code` for a failure (MOTION_FAILED)."""
+        """One goal (action, client, goal) with `groups` claimed; `code` names a failure."""
         return self._claim(
             groups,
             lambda: GoalsExecution(
-                name, [sent], self._now_or_zero, seconds, code or "MOTION_FAILED", on_end=self._command_ended
+                name, [sent], self._now_or_zero, seconds, code, on_end=self._command_ended
             ),
         )
 

@@ -14,6 +14,7 @@ import math
 import threading
 from typing import Any
 
+from action_msgs.msg import GoalStatus
 from geometry_msgs.msg import PoseStamped
 from nav2_msgs.action import ComputePathToPose
 
@@ -61,7 +62,8 @@ def result_of(client: Any, goal: Any, timeout_s: float) -> Any | None:
 
     def on_result(future: Any) -> None:
         response = future.result()
-        outcome["result"] = response.result if response is not None and response.status == 4 else None
+        succeeded = response is not None and response.status == GoalStatus.STATUS_SUCCEEDED
+        outcome["result"] = response.result if succeeded else None
         answered.set()
 
     def on_accepted(future: Any) -> None:

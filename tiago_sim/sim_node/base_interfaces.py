@@ -19,7 +19,6 @@ thread (jobs).
 from __future__ import annotations
 
 import logging
-import math
 from typing import Any
 
 from builtin_interfaces.msg import Duration
@@ -39,6 +38,7 @@ from robot_port.tiago_interfaces import (
     NAVIGATE_TO_POSE,
     UNDOCK_ROBOT,
 )
+from tiago_description import transforms as tf
 from tiago_sim.sim_node.action_server import cancellable_server
 from tiago_sim.sim_node.hardware import MotionExecution
 from tiago_sim.sim_node.localisation_topics import stamp_of
@@ -147,7 +147,7 @@ class ComputePathToPoseServer:
 def pose2d_of(pose: Any) -> tuple[float, float, float]:
     """(x, y, yaw) of a geometry_msgs/Pose on the floor."""
     q = pose.orientation
-    yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+    yaw = tf.yaw_of(tf.from_pose((0.0, 0.0, 0.0), (q.x, q.y, q.z, q.w)))
     return (float(pose.position.x), float(pose.position.y), yaw)
 
 
