@@ -26,7 +26,9 @@ from __future__ import annotations
 import concurrent.futures
 import logging
 import queue
+import sys
 import threading
+import traceback
 from collections.abc import Callable
 from typing import Any, TypeVar
 
@@ -194,13 +196,23 @@ class RosRuntime:
         except concurrent.futures.TimeoutError as error:
             if future.cancel():
                 raise BridgeTimeout(
-                    f"the ROS thread did not answer within {timeout_s:.1f} s (the call was withdrawn)"
+                    f"the ROS thread did not answer within {timeout_s:.1f} s (the call was withdrawn); "
+                    f"it was at: {self._ros_thread_at()}"
                 ) from error
         try:  # it started just now: let it finish rather than leave its effect unknown
             return future.result(timeout=timeout_s)
         except concurrent.futures.TimeoutError as error:
             waited = 2 * timeout_s
             raise BridgeTimeout(f"the ROS thread did not finish a call within {waited:.1f} s") from error
+
+    def _ros_thread_at(self) -> str:
+        """Where the ROS thread is now (its innermost frames), so that a call it never started
+        says whether it was blocked in a callback or waiting in rcl with the call unseen."""
+        frame = sys._current_frames().get(self._thread.ident) if self._thread is not None else None
+        if frame is None:
+            return "(the ROS thread has ended)"
+        frames = traceback.extract_stack(frame)[-4:]
+        return " <- ".join(f"{f.name} ({f.filename.rsplit('/', 1)[-1]}:{f.lineno})" for f in reversed(frames))
 
     def _not_running(self) -> str:
         if self._failure:
@@ -248,6 +260,9 @@ class RosRuntime:
         try:
             while self._context.ok() and not self._stopping.is_set():
                 self._executor.spin_once(timeout_sec=SPIN_PERIOD_S)
+                # The guard's callback drains the queue; this drains what a lost or deferred wake
+                # left (a call must never wait for the next unrelated wake).
+                self._drain_pending_calls()
             if not self._stopping.is_set():
                 self._failure = "the rclpy context was shut down"
         except ExternalShutdownException:

@@ -133,8 +133,9 @@ def test_call_the_ros_thread_never_started_is_withdrawn(runtime: RosRuntime) -> 
     (else a goal reported as not sent could still reach the robot)."""
     stall = runtime.submit(lambda: time.sleep(1.0))
     ran: list[bool] = []
-    with pytest.raises(BridgeTimeout, match="withdrawn"):
+    with pytest.raises(BridgeTimeout, match="withdrawn") as timeout:
         runtime.call(lambda: ran.append(True), timeout_s=0.2)
+    assert "it was at: <lambda> (test_bridge_ros.py" in str(timeout.value), "names what the ROS thread ran"
     stall.result(timeout=5.0)
     assert runtime.call(lambda: "alive") == "alive"
     assert ran == [], "the withdrawn call ran after its caller gave up"
