@@ -6,7 +6,9 @@ perception.detect_marker on the rendered image; the camera pose in base_footprin
 kinematics of the joint readings taken with the image; never from simulator link states.
 
 Target "work_pose" moves the base instead (tiago_skills.base_alignment): from the station's POI to
-the working pose in front of the nests, as the marker shows it. Target "inspect" moves nothing but
+the working pose in front of the nests, as the marker shows it; with the hand empty, it then reads
+where a plate lies in the nest, and a pick grasps it there (tiago_skills.pick_correction).
+Target "inspect" moves nothing but
 the head: it reads from the depth image whether a plate lies in the nest
 (perception.nest_occupancy), the check of a lab whose nests have no sensors.
 
@@ -23,14 +25,11 @@ marker from the head). Lives on: an rclpy executor thread (one goal at a time).
 from __future__ import annotations
 
 import logging
-import math
 import threading
 from collections.abc import Callable
-from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
-from geometry_msgs.msg import Pose
 from labware_interfaces.msg import ErrorCodes
 
 from lab_description.station_placement import approach_heights
@@ -54,45 +53,20 @@ from tiago_skills.bench_route import (
 )
 from tiago_skills.goal_run import ActionAbort, GoalRun
 from tiago_skills.joint_commands import move_joints
+from tiago_skills.marker_sighting import MarkerSighting, pose_msg, same_place
 from tiago_skills.perception.aruco import detect_marker
 from tiago_skills.perception.nest_occupancy import NestView, view_nest
 from tiago_skills.perception.site_frames import nest_in_base
+from tiago_skills.pick_correction import LOOK_AT_NEST, plate_in_nest
 from tiago_skills.place_correction import LOOK_AGAIN, place_shift
 from tiago_skills.reachable import first_reachable
 
 log = logging.getLogger(__name__)
+T = TypeVar("T")
 
 TARGETS = ("site_approach", "site", "work_pose", "inspect")
 LINE_ONLY_RADIUS_M = 0.03  # a tool this near the column above the site moves only in straight lines
 CAMERA_FRAME = "head_front_camera_rgb_optical_frame"
-# A cached marker stays valid while odometry moved less than this.
-SAME_BASE_POSITION_M = 0.002
-SAME_BASE_YAW_RAD = 0.003
-
-
-@dataclass(frozen=True)
-class MarkerSighting:
-    station: str
-    T_base_marker: np.ndarray
-    odometry: tuple[float, float, float]
-    reprojection_error_px: float
-    joints: dict[str, float] = field(default_factory=dict)  # readings taken with the image
-
-
-def same_place(then: tuple[float, float, float], now: tuple[float, float, float]) -> bool:
-    """Whether the base stands where odometry put it `then` (a sighting from there still holds)."""
-    moved = math.hypot(now[0] - then[0], now[1] - then[1])
-    return (
-        moved < SAME_BASE_POSITION_M and abs(math.remainder(now[2] - then[2], math.tau)) < SAME_BASE_YAW_RAD
-    )
-
-
-def pose_msg(transform: np.ndarray) -> Pose:
-    position, quat = tf.to_pose(transform)
-    pose = Pose()
-    pose.position.x, pose.position.y, pose.position.z = (float(v) for v in position)
-    pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w = (float(v) for v in quat)
-    return pose
 
 
 class MarkerMotionBehaviour:
@@ -110,6 +84,8 @@ class MarkerMotionBehaviour:
         self.last_sighting: MarkerSighting | None = None
         # (station, nest) -> (odometry, height) of the floor the last look saw empty in that nest
         self.floors_seen: dict[tuple[str, int], tuple[tuple[float, float, float], float]] = {}
+        # (station, nest) -> (odometry, pose in the nest frame) of the plate the last look found there
+        self.plates_seen: dict[tuple[str, int], tuple[tuple[float, float, float], tf.Planar]] = {}
 
     def look(self, run: GoalRun, station_name: str) -> MarkerSighting:
         """Image + joints at one instant, marker detection, marker pose in base_footprint."""
@@ -164,26 +140,19 @@ class MarkerMotionBehaviour:
         held plate with the head where it saw the marker (place_correction); NEST_NOT_SEEN when the
         camera cannot see into the nest."""
         sighting = self._sighting_here(run, station)
-        T_marker_site = station.T_marker_site(sub_position)
-        height = float((station.T_world_marker() @ T_marker_site)[2, 3])
-        T_base_site = nest_in_base(sighting.T_base_marker, station.T_table_marker(), T_marker_site, height)
+        T_base_site = self._nest_seen(station, sub_position, sighting)
         key, odometry = (station.name, sub_position), run.read(lambda hardware: tuple(hardware.odometry()))
         floor = self.floors_seen.get(key)
         floor_m = floor[1] if floor is not None and same_place(floor[0], odometry) else None
         view = self._view(run, T_base_site, floor_m)
         if not view.seen:
-            joints = run.read(lambda hardware: dict(hardware.joint_positions()))
-            back = {name: joints[name] for name in HEAD_JOINTS}
-            aim = within_head_limits(head_angles_towards(self.kinematics, joints, T_base_site[:3, 3]))
             log.info(
                 "nest %d of %s not seen from here (%s): aiming the head at it",
                 sub_position,
                 station.name,
                 view.reason,
             )
-            run.follow(move_joints(aim), span=(0.2, 0.5))
-            view = self._view(run, T_base_site, floor_m)
-            run.follow(move_joints(back), span=(0.6, 1.0))
+            view = self._aimed_at(run, T_base_site, lambda: self._view(run, T_base_site, floor_m))
         log.info("nest %d of %s: %s", sub_position, station.name, view.reason)
         if view.occupied is False:
             self.floors_seen[key] = (odometry, view.height_m)
@@ -199,13 +168,55 @@ class MarkerMotionBehaviour:
         }
 
     def _view(self, run: GoalRun, T_base_site: np.ndarray, floor_m: float | None) -> NestView:
+        depth, intrinsics, T_site_optical = self._nest_image(run, T_base_site)
+        sizes = [(t.length, t.width, t.height) for t in self.world.labware_types.values()]
+        return view_nest(depth, intrinsics, T_site_optical, sizes, floor_m)
+
+    def _nest_image(self, run: GoalRun, T_base_site: np.ndarray) -> tuple[np.ndarray, Any, np.ndarray]:
+        """A depth image, its intrinsics and the camera's pose in the nest frame when it was taken."""
         run.feedback(max(run.progress, 0.1), "looking into the nest", 0.0, force=True)
         frame = run.read(lambda hardware: hardware.capture_head_camera())
         with self._lock:
             T_base_optical = self.kinematics.forward(frame.joints, CAMERA_FRAME)
-        T_site_optical = tf.invert(T_base_site) @ T_base_optical
-        sizes = [(t.length, t.width, t.height) for t in self.world.labware_types.values()]
-        return view_nest(frame.depth, frame.intrinsics, T_site_optical, sizes, floor_m)
+        return frame.depth, frame.intrinsics, tf.invert(T_base_site) @ T_base_optical
+
+    def _aimed_at(self, run: GoalRun, T_base_site: np.ndarray, look: Callable[[], T]) -> T:
+        """``look()`` with the head aimed at the nest, then turned back: a later place measures its held
+        plate with the head where it saw the marker (place_correction)."""
+        joints = run.read(lambda hardware: dict(hardware.joint_positions()))
+        back = {name: joints[name] for name in HEAD_JOINTS}
+        aim = within_head_limits(head_angles_towards(self.kinematics, joints, T_base_site[:3, 3]))
+        low = max(run.progress, 0.2)
+        run.follow(move_joints(aim), span=(low, low + (1.0 - low) / 3))
+        seen = look()
+        run.follow(move_joints(back), span=(low + 2 * (1.0 - low) / 3, 1.0))
+        return seen
+
+    def _find_plate(self, run: GoalRun, station: Any, sub_position: int, sighting: MarkerSighting) -> None:
+        """Where the plate lies in the nest before a pick (pick_correction), kept for the nest's motions
+        while the base stands here. A put's nest reads empty and keeps nothing."""
+        key = (station.name, sub_position)
+        self.plates_seen.pop(key, None)
+        T_base_site = self._nest_seen(station, sub_position, sighting)
+
+        def plate_seen() -> tuple[tf.Planar | None, str]:
+            return plate_in_nest(*self._nest_image(run, T_base_site), self.world.labware_types.values())
+
+        pose, why = plate_seen()
+        if pose is None and why in LOOK_AT_NEST:
+            log.info("nest %d of %s: %s; aiming the head at it", sub_position, station.name, why)
+            pose, why = self._aimed_at(run, T_base_site, plate_seen)
+        log.info("nest %d of %s: %s", sub_position, station.name, f"plate at {why}" if pose else why)
+        if pose is not None:
+            self.plates_seen[key] = (sighting.odometry, pose)
+
+    def _nest_seen(
+        self, station: Any, sub_position: int, sighting: MarkerSighting, above_m: float = 0.0
+    ) -> np.ndarray:
+        """The nest (or the point ``above_m`` over it) in base_footprint, from a marker sighting."""
+        T_marker_site = station.T_marker_site(sub_position) @ tf.make_transform((0.0, 0.0, above_m))
+        height = float((station.T_world_marker() @ T_marker_site)[2, 3])
+        return nest_in_base(sighting.T_base_marker, station.T_table_marker(), T_marker_site, height)
 
     def _centred_on_plate(
         self,
@@ -304,6 +315,8 @@ class MarkerMotionBehaviour:
             sighting = align_base(
                 run, station, self.kinematics, lambda r: self.look(r, station.name), posture, T_world_work
             )
+            if not self.behaviours.holding.get(arm, False):
+                self._find_plate(run, station, sub_position, sighting)
             return {"marker_in_base": pose_msg(sighting.T_base_marker)}
         if goal.target == "inspect":
             return self.inspect(run, station, sub_position)
@@ -319,11 +332,14 @@ class MarkerMotionBehaviour:
         # The marker's tilt comes from the level bench, not the image (perception.site_frames.upright_marker).
         # The height is the bench's (world file), not the sighting's (perception.site_frames.at_height).
 
+        plate = self.plates_seen.get((station.name, sub_position))  # a pick: the grasp goes to the plate
+        on_plate = (
+            tf.from_planar(*plate[1]) if plate and same_place(plate[0], sighting.odometry) else np.eye(4)
+        )
+
         def site_seen(seen: MarkerSighting, above_m: float = 0.0) -> np.ndarray:
             """The nest (or the point `above_m` over it) in base_footprint, from a marker sighting."""
-            T_marker_site = station.T_marker_site(sub_position) @ tf.make_transform((0.0, 0.0, above_m))
-            height = float((station.T_world_marker() @ T_marker_site)[2, 3])
-            return nest_in_base(seen.T_base_marker, station.T_table_marker(), T_marker_site, height)
+            return self._nest_seen(station, sub_position, seen, above_m) @ on_plate
 
         releasing = goal.target == "site" and self.behaviours.holding.get(arm, False)
         grasp_in_site = self.grasp.T_slot_grasp(approach=False, releasing=releasing)

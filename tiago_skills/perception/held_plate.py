@@ -265,21 +265,24 @@ def locate_held_plate(
     width: float,
     height: float,
     pad_width: float,
+    window_m: float = 0.02,
 ) -> HeldPlateSighting | None:
     """The plate held by a tool at ``tool_in_site`` (grasping frame origin, site frame), or None.
 
     ``points``: depth pixels in the site frame (``site_points``); ``plate_bottom_below_tool``: how
     far below the grasping frame the plate's bottom is expected (the grasp height); ``length``,
     ``width``, ``height``: the plate type's outer size; ``pad_width``: the finger pads' width along
-    the plate's long side (the robot model's), which hides the top face there. Percentile extents
-    trim the same share at both ends, so the centre stays unbiased while a stray pixel cannot move it.
+    the plate's long side (the robot model's), which hides the top face there (0 for a plate resting
+    in a nest, the tool then at the nest's centre); ``window_m``: how far beyond the plate's outline
+    pixels are read (a neighbour's plate must stay outside it). Percentile extents trim the same
+    share at both ends, so the centre stays unbiased while a stray pixel cannot move it.
     The turn comes first, from the four edges; the extents are then read in the plate's own axes (a
     plate turned 1.5 deg reads 2 mm longer in the nest's).
     """
     tool_x, tool_y, tool_z = (float(v) for v in tool_in_site[:3])
     nominal_top = tool_z - plate_bottom_below_tool + height
-    near = (np.abs(points[:, 0] - tool_x) < length / 2 + 0.02) & (
-        np.abs(points[:, 1] - tool_y) < width / 2 + 0.02
+    near = (np.abs(points[:, 0] - tool_x) < length / 2 + window_m) & (
+        np.abs(points[:, 1] - tool_y) < width / 2 + window_m
     )
     inner = near & (np.abs(points[:, 1] - tool_y) < width / 2 - CLEAR_OF_SIDES_M)
     searched = inner & (np.abs(points[:, 2] - nominal_top) < TOP_SEARCH_M)

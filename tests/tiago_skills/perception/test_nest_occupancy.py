@@ -8,28 +8,19 @@ The site frame the check gets comes from the robot's belief, a few millimetres o
 from __future__ import annotations
 
 import numpy as np
-import pybullet as p
 import pytest
 
 from labware_model.labware import LabwareType
+from tests.tiago_skills.perception.bench_scene import RIM, box, nest_rims, rendered_depth
 from tiago_description import transforms as tf
-from tiago_sim.physics.camera import CameraIntrinsics, optical_frame_looking_at, render_rgbd
+from tiago_sim.physics.camera import CameraIntrinsics
 from tiago_skills.perception.nest_occupancy import view_nest
 
 PLATE = LabwareType("sbs", 0.12776, 0.08548, 0.01435, 0.35)
 LOW_PLATE = LabwareType("low", 0.12776, 0.08548, 0.0065, 0.2)
 T_WORLD_SITE = tf.from_xyz_rpy((0.6, -0.25, 0.90), (0.0, 0.0, -np.pi / 2))  # a standing bench
 EYE = np.array([0.05, 0.0, 1.35])
-RIM = 0.006
 DEPTH_NOISE_M = 0.002  # per pixel at this distance: above the disturbance campaigns' 1.9 mm at 1 m
-
-
-def _box(client: int, size, T_world_centre: np.ndarray) -> None:
-    half = [s / 2 for s in size]
-    shape = p.createCollisionShape(p.GEOM_BOX, halfExtents=half, physicsClientId=client)
-    visual = p.createVisualShape(p.GEOM_BOX, halfExtents=half, physicsClientId=client)
-    position, quat = tf.to_pose(T_world_centre)
-    p.createMultiBody(0, shape, visual, position, quat, physicsClientId=client)
 
 
 def _render(
@@ -41,25 +32,19 @@ def _render(
 ):
     """Depth image (with noise) and T_world_optical; `plate_pose` (x, y, z of its bottom, tilt about
     its short side) in the site frame."""
-    client = p.connect(p.DIRECT)
-    try:
-        _box(client, (0.7, 1.0, 0.05), T_WORLD_SITE @ tf.make_transform((0, 0, -0.025)))
-        for side in (-1, 1):  # the nest's rims along both sides and both ends
-            _box(client, (0.15, 0.004, RIM), T_WORLD_SITE @ tf.make_transform((0, side * 0.046, RIM / 2)))
-            _box(client, (0.004, 0.1, RIM), T_WORLD_SITE @ tf.make_transform((side * 0.067, 0, RIM / 2)))
+
+    def draw(client: int) -> None:
+        box(client, (0.7, 1.0, 0.05), T_WORLD_SITE @ tf.make_transform((0, 0, -0.025)))
+        nest_rims(client, T_WORLD_SITE)
         if plate is not None:
             x, y, z, tilt = plate_pose
             centre = tf.from_xyz_rpy((x, y, z + plate.height / 2), (0.0, tilt, 0.0))
-            _box(client, (plate.length, plate.width, plate.height), T_WORLD_SITE @ centre)
+            box(client, (plate.length, plate.width, plate.height), T_WORLD_SITE @ centre)
         if cover:  # a tray held over the nest, hiding all of it
-            _box(client, (0.4, 0.4, 0.03), T_WORLD_SITE @ tf.make_transform((0, 0, 0.12)))
-        target = T_WORLD_SITE[:3, 3] + ([0.0, 0.9, 0.0] if look_away else [0.0, 0.0, 0.0])
-        T_world_optical = optical_frame_looking_at(EYE, target)
-        _rgb, depth = render_rgbd(client, T_world_optical, CameraIntrinsics())
-        noise = np.random.default_rng(7).normal(0.0, DEPTH_NOISE_M, depth.shape)
-        return depth + noise, T_world_optical
-    finally:
-        p.disconnect(client)
+            box(client, (0.4, 0.4, 0.03), T_WORLD_SITE @ tf.make_transform((0, 0, 0.12)))
+
+    target = T_WORLD_SITE[:3, 3] + ([0.0, 0.9, 0.0] if look_away else [0.0, 0.0, 0.0])
+    return rendered_depth(draw, EYE, target, DEPTH_NOISE_M, seed=7)
 
 
 def _view(depth: np.ndarray, T_world_optical: np.ndarray, belief_error=(0.004, -0.003, 0.002)):
