@@ -96,6 +96,7 @@ class RobotBehaviours:
         self.station_pois = station_pois  # a drive to one of these ends with the torso at the bench height
         self.planning = ArmPlanning(seed)
         self.grasp_flipped: dict[str, bool] = {}  # per arm: twin of the top-down grasp last used
+        self.twin_wanted: dict[str, bool | None] = {}  # per arm: the one twin the next put's nest reaches
         self.holding: dict[str, bool] = {}  # per arm: the last gripper command closed on a plate
 
     # -- checks ------------------------------------------------------------------------
@@ -198,8 +199,10 @@ class RobotBehaviours:
         """A top-down grasp pose or its twin with the fingers swapped (half-turn about the approach).
 
         With a plate in the gripper, the twin used when it was grasped, so the plate keeps its
-        orientation from nest to hotel and back; otherwise the one the arm reaches with less joint
-        travel (e.g. 1.5 instead of 2.7 rad from the tucked arm to the hotel).
+        orientation from nest to hotel and back; otherwise the one a put's nest needs (`twin_wanted`:
+        the twin that fetches a plate from the hotel is the one that puts it down) if it reaches, else
+        the one the arm reaches with less joint travel (e.g. 1.5 instead of 2.7 rad from the tucked
+        arm to the hotel).
         """
         twins = {False: T_base_grasp, True: T_base_grasp @ FLIP_ABOUT_APPROACH}
         order = [self.grasp_flipped.get(arm, False)] if self.holding.get(arm) else [False, True]
@@ -209,7 +212,8 @@ class RobotBehaviours:
             if joints is not None:
                 travel[flip] = max(abs(value - seed.get(name, value)) for name, value in joints.items())
         if travel:
-            flip = min(travel, key=travel.get)
+            wanted = None if self.holding.get(arm) else self.twin_wanted.get(arm)
+            flip = wanted if wanted in travel else min(travel, key=travel.get)
             self.grasp_flipped[arm] = flip
             return twins[flip]
         raise ActionAbort(

@@ -57,9 +57,9 @@ from tiago_skills.marker_sighting import MarkerSighting, pose_msg, same_place
 from tiago_skills.perception.aruco import detect_marker
 from tiago_skills.perception.nest_occupancy import NestView, view_nest
 from tiago_skills.perception.site_frames import nest_in_base
-from tiago_skills.pick_correction import LOOK_AT_NEST, plate_in_nest
+from tiago_skills.pick_correction import LOOK_AT_NEST, NEST_EMPTY, plate_in_nest
 from tiago_skills.place_correction import LOOK_AGAIN, place_shift
-from tiago_skills.reachable import first_reachable
+from tiago_skills.reachable import first_reachable, put_twin
 
 log = logging.getLogger(__name__)
 T = TypeVar("T")
@@ -146,12 +146,8 @@ class MarkerMotionBehaviour:
         floor_m = floor[1] if floor is not None and same_place(floor[0], odometry) else None
         view = self._view(run, T_base_site, floor_m)
         if not view.seen:
-            log.info(
-                "nest %d of %s not seen from here (%s): aiming the head at it",
-                sub_position,
-                station.name,
-                view.reason,
-            )
+            where = f"nest {sub_position} of {station.name}"
+            log.info("%s not seen from here (%s): aiming the head at it", where, view.reason)
             view = self._aimed_at(run, T_base_site, lambda: self._view(run, T_base_site, floor_m))
         log.info("nest %d of %s: %s", sub_position, station.name, view.reason)
         if view.occupied is False:
@@ -192,7 +188,7 @@ class MarkerMotionBehaviour:
         run.follow(move_joints(back), span=(low + 2 * (1.0 - low) / 3, 1.0))
         return seen
 
-    def _find_plate(self, run: GoalRun, station: Any, sub_position: int, sighting: MarkerSighting) -> None:
+    def _find_plate(self, run: GoalRun, station: Any, sub_position: int, sighting: MarkerSighting) -> str:
         """Where the plate lies in the nest before a pick (pick_correction), kept for the nest's motions
         while the base stands here. A put's nest reads empty and keeps nothing."""
         key = (station.name, sub_position)
@@ -209,6 +205,7 @@ class MarkerMotionBehaviour:
         log.info("nest %d of %s: %s", sub_position, station.name, f"plate at {why}" if pose else why)
         if pose is not None:
             self.plates_seen[key] = (sighting.odometry, pose)
+        return why
 
     def _nest_seen(
         self, station: Any, sub_position: int, sighting: MarkerSighting, above_m: float = 0.0
@@ -316,7 +313,13 @@ class MarkerMotionBehaviour:
                 run, station, self.kinematics, lambda r: self.look(r, station.name), posture, T_world_work
             )
             if not self.behaviours.holding.get(arm, False):
-                self._find_plate(run, station, sub_position, sighting)
+                self.behaviours.twin_wanted[arm] = None  # a pick takes the twin of least travel
+                if self._find_plate(run, station, sub_position, sighting) == NEST_EMPTY:  # a put
+                    site = self._nest_seen(station, sub_position, sighting)
+                    seed = run.read(lambda hardware: dict(hardware.joint_positions()))
+                    heights = self._approach_heights(station)
+                    wanted = put_twin(self.behaviours, arm, site, heights, self.grasp, seed)
+                    self.behaviours.twin_wanted[arm] = wanted
             return {"marker_in_base": pose_msg(sighting.T_base_marker)}
         if goal.target == "inspect":
             return self.inspect(run, station, sub_position)

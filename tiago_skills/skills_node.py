@@ -89,6 +89,7 @@ class RobotSkills:
     def forget(self) -> None:
         """After a lab reset: no grasp remembered, no marker sighting, no error standing."""
         self.behaviours.grasp_flipped.clear()
+        self.behaviours.twin_wanted.clear()
         self.behaviours.holding.clear()
         self.marker_motion.last_sighting = None
         self.marker_motion.floors_seen.clear()

@@ -18,10 +18,10 @@ from lab_description.world import load_world
 from tests.tiago_sim.sim_node.test_fold_from_hotel import behaviours, benchtop_joints
 from tiago_description import transforms as tf
 from tiago_description.motion_library import load_motions
-from tiago_skills.behaviours import RobotBehaviours
+from tiago_skills.behaviours import FLIP_ABOUT_APPROACH, RobotBehaviours
 from tiago_skills.goal_run import ActionAbort
 from tiago_skills.marker_motion import MarkerMotionBehaviour
-from tiago_skills.reachable import first_reachable
+from tiago_skills.reachable import first_reachable, put_twin
 
 ARM = "right"
 HOTEL = load_motions().hotel
@@ -108,3 +108,49 @@ def test_a_nest_approach_lowers_to_what_the_arm_reaches_but_never_below_a_neighb
     grasps = [place(x, nest_z + height) for height in heights]
     _target, index = first_reachable(holding, ARM, grasps, benchtop_joints())
     assert index > 0
+
+
+def nest(x: float, y: float, z: float = 0.732) -> np.ndarray:
+    """A nest x m ahead and y m to the left, its long side across the base (as a bench ahead has it)."""
+    return tf.from_planar(x, y, -np.pi / 2, z)
+
+
+@pytest.fixture(scope="module")
+def empty_handed() -> RobotBehaviours:
+    return behaviours(seed=0)
+
+
+def test_a_put_nest_only_one_twin_reaches_asks_for_that_twin(empty_handed: RobotBehaviours) -> None:
+    """Near the edge of reach one twin may reach a nest and the other not (random layout 205042: the
+    plate came from the hotel with the other one, IK_FAILED); the put's nest then names its twin, and
+    a nest well within reach names none."""
+    seed, heights = benchtop_joints(), [0.09]
+    assert put_twin(empty_handed, ARM, nest(0.50, -0.20), heights, HOTEL, seed) is None
+    for x in np.arange(0.58, 0.70, 0.005):
+        site = nest(float(x), -0.033)
+        wanted = put_twin(empty_handed, ARM, site, heights, HOTEL, seed)
+        if wanted is None:
+            continue
+        poses = (site @ tf.make_transform((0.0, 0.0, 0.09)) @ HOTEL.T_slot_grasp(False), site @ GRASP)
+        reaches = {
+            flip: all(empty_handed.planning.solve_ik(ARM, pose @ turn, seed) for pose in poses)
+            for flip, turn in ((False, np.eye(4)), (True, FLIP_ABOUT_APPROACH))
+        }
+        assert reaches[wanted] and not reaches[not wanted]
+        return
+    pytest.fail("no nest on the line that only one twin reaches: the model's reach moved")
+
+
+def test_the_hotel_fetch_takes_the_twin_the_put_needs(empty_handed: RobotBehaviours) -> None:
+    """Empty-handed, the twin wanted wins over the one of least travel wherever both reach."""
+    fetch = empty_handed.hotel_grasp_pose(1, approach=False)
+    seed = benchtop_joints()
+    try:
+        for wanted in (False, True):
+            empty_handed.twin_wanted[ARM] = wanted
+            chosen = empty_handed.grasp_twin(ARM, fetch, seed)
+            expected = fetch @ FLIP_ABOUT_APPROACH if wanted else fetch
+            np.testing.assert_allclose(chosen, expected, atol=1e-9)
+            assert empty_handed.grasp_flipped[ARM] is wanted
+    finally:
+        empty_handed.twin_wanted.clear()
