@@ -61,7 +61,9 @@ class ArmPlanning:
         self, arm: str, start: dict[str, float], T_base_grasp: np.ndarray
     ) -> list[dict[str, float]]:
         """Several joint targets for a joint-space move to T_base_grasp, least travel first: the arm
-        alone if it reaches, else with the torso (`RobotKinematics.solutions`)."""
+        alone if it reaches, else with the torso (`RobotKinematics.solutions`); at the edge of reach,
+        where those few starts find none, the one `solve_ik` finds (the solve that judged the target
+        reachable: without it a route to an approach 0.97 m high found no way, IK_FAILED)."""
         for use_torso in (False, True):
             with self._lock:
                 found = self._kinematics.solutions(
@@ -69,7 +71,8 @@ class ArmPlanning:
                 )
             if found:
                 return found
-        return []
+        thorough = self.solve_ik(arm, T_base_grasp, start)
+        return [thorough] if thorough is not None else []
 
     def clearance(
         self,

@@ -154,3 +154,22 @@ def test_the_hotel_fetch_takes_the_twin_the_put_needs(empty_handed: RobotBehavio
             assert empty_handed.grasp_flipped[ARM] is wanted
     finally:
         empty_handed.twin_wanted.clear()
+
+
+@pytest.mark.parametrize(
+    ("flip", "x", "y", "z"),
+    [(False, 0.50, -0.10, 0.96), (False, 0.57, -0.23, 0.93), (True, 0.47, -0.10, 0.96)],
+)
+def test_a_route_finds_a_joint_goal_wherever_the_reach_check_reached(
+    empty_handed: RobotBehaviours, flip: bool, x: float, y: float, z: float
+) -> None:
+    """At the edge of reach, where a few random IK starts find no solution but the reach check's
+    thorough solve does (a route to an approach 0.97 m high found no way: IK_FAILED)."""
+    target = nest(x, y, z) @ HOTEL.T_slot_grasp(False) @ (FLIP_ABOUT_APPROACH if flip else np.eye(4))
+    seed = benchtop_joints()
+    assert empty_handed.planning.solve_ik(ARM, target, seed) is not None, "the model's reach moved"
+    goals = empty_handed.planning.joint_move_goals(ARM, seed, target)
+    assert goals, "the route has no joint-space goal for a target the reach check reached"
+    for goal in goals:
+        reached = empty_handed.planning.tool_pose(ARM, {**seed, **goal})
+        np.testing.assert_allclose(reached[:3, 3], target[:3, 3], atol=1e-3)
