@@ -39,8 +39,8 @@ def rules() -> list[str]:
         "is served that way).",
         f"**Approach height** (`nests.approach_height`): {placement.PREFERRED_APPROACH_HEIGHT_M:.2f} m "
         f"above the nest, lowered in {placement.APPROACH_HEIGHT_STEP_M * 100:.0f} cm steps where the "
-        "arm cannot reach that high, to no less than the tallest labware type plus "
-        f"{placement.APPROACH_CLEARANCE_M:.2f} m.",
+        "arm cannot reach that high, then to the least: the tallest labware type plus "
+        f"{placement.APPROACH_CLEARANCE_M:.2f} m, never lower.",
         "**Refused: a nest out of reach**: from the pose it is worked at from, no torso height "
         f"({torso_low:g} to {torso_high:g} m) and right-arm pose puts the gripper top-down on it, at the "
         "grasp and at the approach height; the message says how high the arm reaches there.",

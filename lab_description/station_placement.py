@@ -106,11 +106,15 @@ def centred_lateral(station, arm: str = REACH_ARM) -> float:  # noqa: ANN001
 
 
 def approach_heights(tallest_labware_m: float) -> list[float]:
-    """The approach heights to try, preferred first, down to the least that clears a neighbour's plate."""
-    least = tallest_labware_m + APPROACH_CLEARANCE_M
-    heights = [PREFERRED_APPROACH_HEIGHT_M]
+    """The approach heights to try, preferred first, in steps down to the least that clears a neighbour's
+    plate, that least one last (an approach 6 mm lower than the last step reached a nest 0.96 m high
+    near the base's centre line that the step did not: random layout 193101)."""
+    least = math.ceil((tallest_labware_m + APPROACH_CLEARANCE_M) * 1000.0 - 1e-6) / 1000.0  # mm, up
+    heights = [max(PREFERRED_APPROACH_HEIGHT_M, least)]  # a plate taller than 8 cm: only the least
     while heights[-1] - APPROACH_HEIGHT_STEP_M >= least - 1e-9:
         heights.append(round(heights[-1] - APPROACH_HEIGHT_STEP_M, 3))
+    if heights[-1] - least > 0.001:
+        heights.append(least)
     return heights
 
 

@@ -97,3 +97,18 @@ def test_a_long_row_is_worked_at_from_poses_moved_along_the_bench() -> None:
         assert inward <= rm.TOP_DOWN_REACH_BAND_M - placement.ARM_SIDE_MARGIN_M + 1e-9
         offsets.append(moved[1, 3])
     assert offsets[0] > 0 > offsets[-1] and offsets[2] == offsets[3] == 0.0
+
+
+@pytest.mark.parametrize("tallest", [0.01435, 0.0441, 0.0641, 0.09])
+def test_approach_heights_step_down_to_the_least_that_clears_a_neighbour_and_end_there(
+    tallest: float,
+) -> None:
+    """Preferred first, in steps, then the least itself (a nest 0.96 m high near the base's centre
+    line was reached 6 mm under the last step and not at it), never below the tallest plate plus the
+    clearance, to the millimetre."""
+    heights = placement.approach_heights(tallest)
+    least = tallest + placement.APPROACH_CLEARANCE_M
+    assert heights == sorted(heights, reverse=True) and len(set(heights)) == len(heights)
+    assert all(height >= least - 1e-9 for height in heights)
+    assert heights[-1] - least < 0.001, "the least height is tried last"
+    assert heights[0] == max(placement.PREFERRED_APPROACH_HEIGHT_M, heights[-1])
