@@ -8,33 +8,21 @@ is not shared between threads. Pure computation, no hardware.
 from __future__ import annotations
 
 import threading
-from collections import ChainMap
-from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 
-from robot_port.types import ARM_SIDES
 from tiago_description.arm_clearance import ArmClearance, Box, Clearance, HeldBox
 from tiago_description.kinematics import RobotKinematics
-from tiago_description.motion_library import MotionLibrary
 from tiago_skills.joint_rrt import plan_around
 from tiago_skills.tool_path import plan_tool_path
-
-
-def reach_seeds(motions: MotionLibrary) -> dict[str, dict[str, float]]:
-    """Per arm, the bench posture (`Benchtop`'s keyframes merged): where the loader judges reach from."""
-    return {arm: dict(ChainMap(*reversed(motions.frames_for("Benchtop", arm)))) for arm in ARM_SIDES}
 
 
 class ArmPlanning:
     """IK and FK on the robot model, with the seeds of IK restarts drawn from one generator."""
 
-    def __init__(
-        self, seed: int | None = None, reach_seeds: Mapping[str, dict[str, float]] | None = None
-    ) -> None:
+    def __init__(self, seed: int | None = None) -> None:
         self._rng = np.random.default_rng(seed)
-        self._reach_seeds = dict(reach_seeds or {})  # per arm: the posture the loader judges reach from
         self._kinematics = RobotKinematics()
         self._clearance = ArmClearance(self._kinematics)
         self._lock = threading.Lock()
@@ -46,21 +34,12 @@ class ArmPlanning:
     def solve_ik(
         self, arm: str, T_base_grasp: Any, seed_positions: dict[str, float], *, use_torso: bool = True
     ) -> dict[str, float] | None:
-        """Joint targets for the grasping frame at T_base_grasp, or None when unreachable: solved from
-        `seed_positions`, then from the posture the loader judged the lab's reach from (`reach_seeds`).
-
-        Why the second: at the edge of reach the solutions are a thin set that restarts from the
-        joints of the moment can miss; the loader had accepted a nest approach 0.96 m high from its
-        posture, and the put found it out of reach (random layout 193101, IK_FAILED)."""
-        starts = [seed_positions]
-        if arm in self._reach_seeds:
-            starts.append({**seed_positions, **self._reach_seeds[arm]})
-        for start in starts:
-            with self._lock:
-                result = self._kinematics.inverse(arm, T_base_grasp, start, use_torso=use_torso, restarts=60)
-            if result.success:
-                return dict(result.joint_positions)
-        return None
+        """Joint targets for the grasping frame at T_base_grasp, or None when unreachable."""
+        with self._lock:
+            result = self._kinematics.inverse(
+                arm, T_base_grasp, seed_positions, use_torso=use_torso, restarts=60
+            )
+        return dict(result.joint_positions) if result.success else None
 
     def plan_line(
         self, arm: str, start: dict[str, float], T_base_grasp: np.ndarray, *, use_torso: bool

@@ -22,7 +22,7 @@ from robot_port.types import ARM_SIDES, JointTrajectory
 from tiago_description import robot_model as rm
 from tiago_description.motion_library import HOTEL_MOTIONS, MotionLibrary
 from tiago_description.transforms import make_transform
-from tiago_skills.arm_planning import ArmPlanning, reach_seeds
+from tiago_skills.arm_planning import ArmPlanning
 from tiago_skills.drive_estimate import planned_drive_s
 from tiago_skills.drive_posture import torso_for_drive
 from tiago_skills.goal_run import ActionAbort, GoalRun
@@ -94,7 +94,7 @@ class RobotBehaviours:
         self.speed_scale = speed_scale
         self.plate_widths = plate_widths  # the short sides of the lab's plate types: what a grasp spans
         self.station_pois = station_pois  # a drive to one of these ends with the torso at the bench height
-        self.planning = ArmPlanning(seed, reach_seeds(motions))
+        self.planning = ArmPlanning(seed)
         self.grasp_flipped: dict[str, bool] = {}  # per arm: twin of the top-down grasp last used
         self.twin_wanted: dict[str, bool | None] = {}  # per arm: the one twin the next put's nest reaches
         self.holding: dict[str, bool] = {}  # per arm: the last gripper command closed on a plate

@@ -59,7 +59,7 @@ from tiago_skills.perception.nest_occupancy import NestView, view_nest
 from tiago_skills.perception.site_frames import nest_in_base
 from tiago_skills.pick_correction import LOOK_AT_NEST, NEST_EMPTY, plate_in_nest
 from tiago_skills.place_correction import LOOK_AGAIN, place_shift
-from tiago_skills.reachable import approach_target, first_reachable, put_twin
+from tiago_skills.reachable import first_reachable, put_twin
 
 log = logging.getLogger(__name__)
 T = TypeVar("T")
@@ -360,8 +360,7 @@ class MarkerMotionBehaviour:
         else:
             heights = self._approach_heights(station)
             grasps = [site_seen(sighting, height) @ grasp_in_site for height in heights]
-            in_column = self._in_the_column(run, arm, grasps[0])
-            T_base_target, index = approach_target(self.behaviours, arm, grasps, seed, in_column)
+            T_base_target, index = first_reachable(self.behaviours, arm, grasps, seed)
             if index:
                 log.warning(
                     "the %s arm does not reach %.0f mm above nest %d of %s: approaching at %.0f mm",

@@ -7,7 +7,6 @@ Lives on the calling goal's thread (the arm planning's IK is the caller's).
 from __future__ import annotations
 
 import logging
-import math
 
 import numpy as np
 
@@ -38,35 +37,6 @@ def first_reachable(
             failure = failure or unreachable
     assert failure is not None, "no grasp pose given"
     raise failure
-
-
-def approach_target(
-    behaviours: RobotBehaviours, arm: str, grasps: list[np.ndarray], seed: dict[str, float], in_column: bool
-) -> tuple[np.ndarray, int]:
-    """`first_reachable`; and for a tool already in the nest's column (a retract or a lift, `in_column`)
-    whose targets that check finds out of reach, the first a straight line up from the joints now
-    reaches, with the twin the tool has now.
-
-    Why: at the edge of reach the IK solve from the joints at the nest can miss the approach the arm
-    stood at moments before (random layout 193101: the place went in by a joint-space goal the route
-    found, and its retract failed with IK_FAILED at the same point); the line up is the motion that
-    follows, and its waypoints are solved one from the last."""
-    try:
-        return first_reachable(behaviours, arm, grasps, seed)
-    except ActionAbort:
-        if not in_column:
-            raise
-        tool = behaviours.planning.tool_pose(arm, seed)
-        for index, T_base_grasp in enumerate(grasps):
-            flip = tf.rotation_angle(tool[:3, :3], (T_base_grasp @ FLIP_ABOUT_APPROACH)[:3, :3]) < math.pi / 2
-            target = T_base_grasp @ FLIP_ABOUT_APPROACH if flip else T_base_grasp
-            if not isinstance(behaviours.planning.plan_line(arm, seed, target, use_torso=True), str):
-                log.warning(
-                    "the approach is reached by the line up from the nest only (%d of %d)", index, len(grasps)
-                )
-                behaviours.grasp_flipped[arm] = flip
-                return target, index
-        raise
 
 
 def twin_reaching(
