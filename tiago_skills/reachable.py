@@ -77,7 +77,7 @@ def put_twin(
         T_base_site @ tf.make_transform((0.0, 0.0, h)) @ grasp.T_slot_grasp(False) for h in approach_heights
     ]
     place = T_base_site @ grasp.T_slot_grasp(False, releasing=True)
-    wanted = twin_reaching(behaviours, arm, [over, [place]], seed)
+    wanted = twin_reaching(behaviours, arm, [[place], over], seed)  # the place first: one pose
     if wanted is not None:
         log.info("only the %s twin reaches the put's nest: the plate is fetched with it", TWINS[wanted])
     return wanted
