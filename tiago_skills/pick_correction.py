@@ -16,7 +16,6 @@ Only the head camera's depth image and joint readings are used, as on the real r
 
 from __future__ import annotations
 
-import logging
 import math
 from collections.abc import Iterable
 
@@ -26,10 +25,8 @@ from labware_model.labware import LabwareType
 from robot_port.types import CameraIntrinsics
 from tiago_description import transforms as tf
 from tiago_skills.perception.held_plate import HeldPlateSighting, locate_held_plate, site_points
-from tiago_skills.perception.nest_occupancy import view_nest
+from tiago_skills.perception.nest_occupancy import view_points
 from tiago_skills.place_correction import MAX_SHIFT_M, MAX_TURN_RAD
-
-log = logging.getLogger(__name__)
 
 # Pixels are read this far beyond a plate's outline about the nest's centre: a plate lies up to its
 # pocket's clearance and the nest's mounting error (about 8 mm) off it, and a neighbour's plate in a
@@ -52,12 +49,12 @@ def plate_in_nest(
     """The plate's pose (x, y, yaw) in the nest's site frame as the camera sees it at
     ``T_site_optical``, and a description of it; or None and why not."""
     types = list(plate_types)
-    view = view_nest(depth, intrinsics, T_site_optical, [(t.length, t.width, t.height) for t in types])
+    points = site_points(depth, intrinsics, T_site_optical)  # once, for both reads
+    view = view_points(points, [(t.length, t.width, t.height) for t in types])
     if not view.seen:
         return None, NEST_NOT_IN_VIEW
     if not view.occupied:
         return None, NEST_EMPTY
-    points = site_points(depth, intrinsics, T_site_optical)
     found: HeldPlateSighting | None = None
     for plate in sorted(types, key=lambda t: abs(t.height - view.height_m)):  # the type seen first
         found = _located(points, plate, np.zeros(3))

@@ -69,13 +69,19 @@ def view_nest(
     """Whether the nest whose site frame the camera sees at `T_site_optical` holds a plate of one
     of the lab's types (`plate_sizes`: length, width, height in m), and whether it is seated;
     `floor_m`: the height this nest's empty floor was seen at from the same place, if it was."""
+    return view_points(site_points(depth_m, intrinsics, T_site_optical), plate_sizes, floor_m)
+
+
+def view_points(
+    points: np.ndarray, plate_sizes: Iterable[tuple[float, float, float]], floor_m: float | None = None
+) -> NestView:
+    """`view_nest` on depth pixels already in the nest's site frame (`site_points`)."""
     sizes = np.array(list(plate_sizes), dtype=float).reshape(-1, 3)
     if not len(sizes):
         raise ValueError("no plate types: nothing to look for")
     half_length = sizes[:, 0].min() / 2 - FOOTPRINT_MARGIN_M
     half_width = sizes[:, 1].min() / 2 - FOOTPRINT_MARGIN_M
     lowest, tallest = float(sizes[:, 2].min()), float(sizes[:, 2].max())
-    points = site_points(depth_m, intrinsics, T_site_optical)
     inside = (np.abs(points[:, 0]) < half_length) & (np.abs(points[:, 1]) < half_width)
     footprint = points[inside & (points[:, 2] > -BELOW_FLOOR_M)]
     count = len(footprint)
