@@ -77,6 +77,18 @@ ESCAPE_DIRECTIONS = 72
 ESCAPE_MAX_M = 1.5
 
 
+def _escape_arms_half_width(distance: float, leaving: bool) -> float:
+    """The folded arms' band `distance` along a straight segment out of the start (`leaving`) or into
+    the goal. Leaving, the robot stands at the start with its arms folded and touching nothing; backing
+    straight out, an arm strays sideways only by the drive's heading error over the distance driven,
+    so the margin grows from nothing to FOOTPRINT_MARGIN_M. With the whole margin at the start, an
+    arm 0.49 to 0.51 m from a neighbouring bench's corner, where it had worked, kept the robot from
+    leaving (random layouts 207020 and 207101: NAVIGATION_FAILED after the pick or the place)."""
+    if not leaving:
+        return ARMS_HALF_WIDTH_M
+    return ARM_SWEEP_RADIUS_M + min(FOOTPRINT_MARGIN_M, math.tan(ALONG_HEADING_RAD) * distance)
+
+
 def _coarsened(grid: OccupancyMap, cost: np.ndarray, factor: int) -> tuple[OccupancyMap, np.ndarray]:
     """A grid of `factor` x `factor` blocks: a block is occupied if any of its cells is, and costs
     what its dearest cell does (the edge beyond the map counts as occupied)."""
@@ -138,10 +150,6 @@ class GlobalPlanner:
         default: everything on the static map, as for obstacles of unknown height)."""
         self.static_map = static_map
         self.arms_map = static_map if arms_map is None else arms_map
-        # across a segment, every half cell out to the arms' reach on either side
-        self._arm_offsets = np.arange(
-            -ARMS_HALF_WIDTH_M, ARMS_HALF_WIDTH_M + 1e-9, self.arms_map.resolution / 2
-        )
         clearance = static_map.clearance_m()
         self.clearance = clearance
         self.inflated = static_map.inflated(INFLATION_RADIUS_M)
@@ -210,12 +218,12 @@ class GlobalPlanner:
         here = float(self.clearance[row, col])
         for direction in directions:
             dx, dy = math.cos(direction), math.sin(direction)
-            if not self._arms_clear((x, y), direction):
-                continue
-            distance = step
+            distance = 0.0
             while distance <= ESCAPE_MAX_M:
                 point = (x + dx * distance, y + dy * distance)
-                if not self._base_clear(point, leaving, here) or not self._arms_clear(point, direction):
+                if not self._base_clear(point, leaving, here):
+                    break
+                if not self._arms_clear(point, direction, _escape_arms_half_width(distance, leaving)):
                     break
                 if self.inflated.is_free(*point):
                     if best is None or distance < best[0]:
@@ -229,11 +237,12 @@ class GlobalPlanner:
         if best is None:
             what = "start" if leaving else "goal"
             rule = "in any direction" if may_turn else "along its heading (it cannot turn there)"
+            band = f"{ARM_SWEEP_RADIUS_M:.2f} m at first, then " if leaving else ""
+            band += f"{ARMS_HALF_WIDTH_M:.2f} m"
             raise PlanningError(
                 f"the {what} ({x:.2f}, {y:.2f}) is {self.clearance[row, col]:.2f} m from an obstacle and "
                 f"no straight segment {rule} reaches {INFLATION_RADIUS_M:.2f} m clearance "
-                f"within {ESCAPE_MAX_M} m with nothing within {ARMS_HALF_WIDTH_M:.2f} m beside it "
-                "(the folded arms)"
+                f"within {ESCAPE_MAX_M} m with nothing within {band} beside it (the folded arms)"
             )
         return best[1], best[2]
 
@@ -319,10 +328,13 @@ class GlobalPlanner:
         return cells[::-1]
 
     # -- straight segments ----------------------------------------------------------------
-    def _arms_clear(self, point: tuple[float, float], direction: float) -> bool:
-        """Nothing as high as the folded arms beside `point` within their reach, across a straight
+    def _arms_clear(
+        self, point: tuple[float, float], direction: float, half_width: float = ARMS_HALF_WIDTH_M
+    ) -> bool:
+        """Nothing as high as the folded arms beside `point` within `half_width`, across a straight
         segment driven along `direction` (the line through the point at right angles to it)."""
-        grid, offsets = self.arms_map, self._arm_offsets
+        samples = math.ceil(2 * half_width / (self.arms_map.resolution / 2)) + 1  # every half cell
+        grid, offsets = self.arms_map, np.linspace(-half_width, half_width, samples)
         return _points_free(
             grid, point[0] - math.sin(direction) * offsets, point[1] + math.cos(direction) * offsets
         )

@@ -4,6 +4,7 @@ its documented ranges, keeps the demo transfer possible, and is the same for the
 from __future__ import annotations
 
 import copy
+import io
 import subprocess
 import sys
 from functools import cache
@@ -17,6 +18,7 @@ from hypothesis import strategies as st
 from lab_description.serviceability import bench_distance
 from lab_description.world import load_world, world_from_raw
 from labware_model.holders import Nest
+from tiago_sim.inspection.world_check import INVALID_WORLD_EXIT_CODE, check_world
 from tiago_sim.layouts.generator import (
     DOCK_BOX,
     DOCK_BOX_BEHIND,
@@ -28,6 +30,7 @@ from tiago_sim.layouts.layout_file import layout_yaml
 from tiago_sim.layouts.station_draw import LABWARE_TYPES, RANGES
 
 REPOSITORY = Path(__file__).resolve().parents[3]
+FIXTURES = Path(__file__).resolve().parent / "fixtures"
 
 
 @cache
@@ -121,3 +124,27 @@ def test_a_poi_the_planner_cannot_reach_once_navigation_stops_off_it_is_drawn_ag
     assert problems and all("dispenser_work 0.06 m off" in line for line in problems), problems
     assert "no straight segment along its heading" in problems[0]
     assert route_problems(load_world(kept.with_name("layout_83184.yaml"))) == []
+
+
+def test_a_working_pose_moved_along_the_bench_that_the_robot_could_not_leave_is_refused() -> None:
+    """Random layout 207077 (kept from the campaign at bda4b3d): the labeler's nests 1 and 2 lay
+    outside the arm's band, and the poses they were worked at from, moved along the bench, stood with
+    a neighbour behind and beside them: the robot worked there and then had no way out
+    (NAVIGATION_FAILED). `world check` and the drawing now plan out of every pose the robot works at."""
+    kept = FIXTURES / "layout_207077.yaml"
+    problems = route_problems(load_world(kept))
+    assert [line.split(" (")[0] for line in problems] == [
+        f"layout: stations: labeler: the robot could not leave the working pose for nest {nest}"
+        for nest in (1, 2)
+    ], problems
+    assert all("no straight segment along its heading" in line for line in problems)
+    out, err = io.StringIO(), io.StringIO()
+    assert check_world(kept, None, out, err) == INVALID_WORLD_EXIT_CODE
+    assert err.getvalue().splitlines() == [line.replace("layout:", f"{kept}:", 1) for line in problems]
+
+
+def test_the_robot_leaves_a_working_pose_beside_a_corner_its_folded_arm_clears() -> None:
+    """Random layout 207020 (kept from the campaign at bda4b3d): at the labeler's nest 1 a neighbour's
+    corner stood 0.49 to 0.51 m beside the folded arm. The arms' 3 cm margin for the drive's error
+    now grows from nothing as the robot backs out (it stood there touching nothing): a way out."""
+    assert route_problems(load_world(FIXTURES / "layout_207020.yaml")) == []
