@@ -98,6 +98,7 @@ class RobotBehaviours:
         self.grasp_flipped: dict[str, bool] = {}  # per arm: twin of the top-down grasp last used
         self.twin_wanted: dict[str, bool | None] = {}  # per arm: the one twin the next put's nest reaches
         self.holding: dict[str, bool] = {}  # per arm: the last gripper command closed on a plate
+        self.bench_exit: Callable[[GoalRun, str, np.ndarray, tuple[float, float]], bool] | None = None
 
     # -- checks ------------------------------------------------------------------------
     def arm_of(self, requested: str) -> str:
@@ -326,9 +327,9 @@ class RobotBehaviours:
         return 0.0
 
     def leave_bench(self, run: GoalRun, arm: str) -> float:
-        """If the tool is over a bench (ahead of BENCH_FRONT_X), go straight back to that line at its
-        height first; returns the progress used. The tool leaves a bench from a nest's approach pose,
-        which clears everything on it."""
+        """If the tool is over a bench (ahead of BENCH_FRONT_X), go back to that line at its height
+        first, straight if it can, else by the first way clear of the station's board, bench and
+        labware (`bench_exit`); returns the progress used."""
         joints = run.read(lambda hardware: dict(hardware.joint_positions()))
         T_tool = self.planning.tool_pose(arm, joints)
         if T_tool[0, 3] <= BENCH_FRONT_X + BENCH_EDGE_MARGIN / 2:  # on the line ("Benchtop"), or behind it
@@ -340,10 +341,10 @@ class RobotBehaviours:
         except ActionAbort as abort:
             if abort.code != ErrorCodes.IK_FAILED:
                 raise
-            # Near the body the wrist may have to turn over along the line (a joint jump): the short
-            # joint-space move between the two level poses stays close to that level.
-            log.info("no straight way back from over the bench (%s): moving in joint space", abort.message)
-            self.joint_space_move(run, arm, T_front, (0.0, 0.3))
+            # Near the body the wrist may have to turn over along the line (a joint jump)
+            log.info("no straight way back from over the bench (%s)", abort.message)
+            if self.bench_exit is None or not self.bench_exit(run, arm, T_front, (0.0, 0.3)):
+                self.joint_space_move(run, arm, T_front, (0.0, 0.3))  # no station seen: one unchecked move
         return 0.3
 
     def rise_before_bench(self, run: GoalRun, arm: str, T_base_target: np.ndarray, first: float) -> float:

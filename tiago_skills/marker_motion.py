@@ -44,13 +44,8 @@ from tiago_skills.behaviours import (
     TOOL_SPEED_INTO_POCKET,
     RobotBehaviours,
 )
-from tiago_skills.bench_route import (
-    BenchRoute,
-    held_plate_box,
-    largest_labware,
-    nest_labware_boxes,
-    station_boxes,
-)
+from tiago_skills.bench_exit import BenchExit
+from tiago_skills.bench_route import BenchRoute, held_plate_box, largest_labware
 from tiago_skills.goal_run import ActionAbort, GoalRun
 from tiago_skills.joint_commands import move_joints
 from tiago_skills.marker_sighting import MarkerSighting, pose_msg, same_place
@@ -79,6 +74,8 @@ class MarkerMotionBehaviour:
         self.route = BenchRoute(behaviours)
         self.held_plate = held_plate_box(list(world.labware_types.values()), grasp)
         self.largest_labware = largest_labware(list(world.labware_types.values()))
+        self.exit = BenchExit(self.route, self.held_plate, self.largest_labware, self._cached)
+        behaviours.bench_exit = self.exit  # the arm's way back off the bench (Tuck, a put into the hotel)
         self.kinematics = RobotKinematics()
         self._lock = threading.Lock()
         self.last_sighting: MarkerSighting | None = None
@@ -326,6 +323,7 @@ class MarkerMotionBehaviour:
         sighting = self._cached(run, station.name)
         if sighting is None:
             sighting = self.look(run, station.name)
+        self.exit.over(arm, station, sub_position)
         marker_in_base = pose_msg(sighting.T_base_marker)
         seed = run.read(lambda hardware: dict(hardware.joint_positions()))
         # Nests sit on level benches and the base stands on the floor, so the nest frame is levelled:
@@ -382,15 +380,8 @@ class MarkerMotionBehaviour:
             holding = self.behaviours.holding.get(arm, False)
             # An empty gripper may come down as either twin: the other one may have a clear way.
             targets = [T_base_target] if holding else [T_base_target, T_base_target @ FLIP_ABOUT_APPROACH]
-            # Any nest may hold labware (the skills do not read the nests' sensors), but the one a
-            # held plate goes into is empty (the sequencer checked it).
-            stocked = [n for n in range(1, station.sub_positions + 1) if not (holding and n == sub_position)]
-            boxes = station_boxes(station, sighting.T_base_marker) + nest_labware_boxes(
-                station, sighting.T_base_marker, stocked, self.largest_labware
-            )
-            reached = self.route.move(
-                run, arm, targets, speed, (first, 1.0), boxes, self.held_plate if holding else None
-            )
+            boxes = self.exit.boxes(station, sighting, sub_position, holding)
+            reached = self.route.move(run, arm, targets, speed, (first, 1.0), boxes, self.exit.held(arm))
             if reached:
                 self.behaviours.grasp_flipped[arm] = not self.behaviours.grasp_flipped.get(arm, False)
         except ActionAbort as abort:

@@ -3,7 +3,8 @@
 Why: a lab integrator describes their own lab; the robot must serve ordinary furniture, not labs
 drawn to suit it. Each seed draws a floor plan from `station_draw.RANGES` with no robot field in
 it (the floor-plan rules only: benches inside the floor, clear of each other and of the drives),
-and the loader then checks it with the robot model, as `world check` does. A refused lab lists
+and it is then checked as `world check` does: the loader with the robot model, and the planner's
+ways between the POIs and out of every pose the robot works at. A refused lab lists
 each reason; `reason_kind` sorts them for the table.
 
     python -m tiago_sim.layouts.acceptance FIRST COUNT
@@ -20,6 +21,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from lab_description.world import WorldError, world_from_raw
+from tiago_sim.inspection.poi_paths import plan_poi_paths
 from tiago_sim.layouts.generator import draw_floor_plan
 
 
@@ -38,16 +40,24 @@ class Verdict:
 
 def check_seed(seed: int) -> Verdict:
     """The first floor plan drawn for `seed`, checked with the robot model."""
-    raw = draw_floor_plan(random.Random(seed), seed)
+    return check_lab(seed, draw_floor_plan(random.Random(seed), seed))
+
+
+def check_lab(seed: int, raw: dict) -> Verdict:
+    """A drawn lab checked as `world check` does: the loader, then the robot's ways between the POIs
+    and out of every pose it works at (`poi_paths`)."""
+    source = f"furniture lab {seed}"
     try:
-        world_from_raw(raw, f"furniture lab {seed}")
+        world = world_from_raw(raw, source)
     except WorldError as error:
         return Verdict(seed, raw, error.problems)
-    return Verdict(seed, raw, ())
+    return Verdict(seed, raw, tuple(plan_poi_paths(world).problems(source)))
 
 
 def reason_kind(problem: str) -> str:
-    """A refusal's kind: reach, view, base (footprint or turning room) or other."""
+    """A refusal's kind: reach, view, base (footprint or turning room), the robot's ways, or other."""
+    if re.search(r"no path for the robot|could not leave", problem):
+        return "no way for the robot"  # first: the planner's reasons say "reaches"
     if "reach" in problem:
         return "a nest out of reach"
     if "cannot see marker" in problem:
