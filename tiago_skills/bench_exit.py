@@ -65,6 +65,7 @@ class BenchExit:
         sighting = self.sighting_here(run, station.name)
         if sighting is None:
             return False
-        boxes = self.boxes(station, sighting, sub_position, self.held(arm) is not None)
-        self.route.move(run, arm, [T_front], TOOL_SPEED_FREE, span, boxes, self.held(arm))
+        held = self.held(arm)
+        boxes = self.boxes(station, sighting, sub_position, held is not None)
+        self.route.move(run, arm, [T_front], TOOL_SPEED_FREE, span, boxes, held)
         return True

@@ -60,8 +60,8 @@ def plan_poi_paths(world: World) -> PoiPaths:
             paths.append(PoiPath(start_name, goal_name, None, error.reason))
         else:
             paths.append(PoiPath(start_name, goal_name, plan))
-    dock_pairs = [(path.start, path.goal) for path in paths if path.plan is None]
-    cut_off = {name for pair in dock_pairs if world.dock_poi in pair for name in pair}
+    unplanned = [(path.start, path.goal) for path in paths if path.plan is None]
+    cut_off = {name for pair in unplanned if world.dock_poi in pair for name in pair}
     return PoiPaths(planner, tuple(paths), tuple(working_pose_exits(world, planner, cut_off)))
 
 

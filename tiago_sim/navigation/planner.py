@@ -25,6 +25,7 @@ import heapq
 import math
 import time
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -87,6 +88,16 @@ def _escape_arms_half_width(distance: float, leaving: bool) -> float:
     if not leaving:
         return ARMS_HALF_WIDTH_M
     return ARM_SWEEP_RADIUS_M + min(FOOTPRINT_MARGIN_M, math.tan(ALONG_HEADING_RAD) * distance)
+
+
+@lru_cache(maxsize=64)
+def _band_offsets(half_width: float, resolution: float) -> np.ndarray:
+    """Offsets across a segment, every half cell from one edge of a band to the other (the escape's
+    bands take a few dozen widths: made once each, not per sample of a segment)."""
+    samples = math.ceil(2 * half_width / (resolution / 2)) + 1
+    offsets = np.linspace(-half_width, half_width, samples)
+    offsets.setflags(write=False)  # shared by every call
+    return offsets
 
 
 def _coarsened(grid: OccupancyMap, cost: np.ndarray, factor: int) -> tuple[OccupancyMap, np.ndarray]:
@@ -333,8 +344,7 @@ class GlobalPlanner:
     ) -> bool:
         """Nothing as high as the folded arms beside `point` within `half_width`, across a straight
         segment driven along `direction` (the line through the point at right angles to it)."""
-        samples = math.ceil(2 * half_width / (self.arms_map.resolution / 2)) + 1  # every half cell
-        grid, offsets = self.arms_map, np.linspace(-half_width, half_width, samples)
+        grid, offsets = self.arms_map, _band_offsets(round(half_width, 4), self.arms_map.resolution)
         return _points_free(
             grid, point[0] - math.sin(direction) * offsets, point[1] + math.cos(direction) * offsets
         )
