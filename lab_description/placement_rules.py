@@ -47,7 +47,9 @@ def rules() -> list[str]:
         f"**Refused: no room for the base**: the base disc (radius {base}) at the docked pose, and "
         f"{working} at every working pose, clear every bench; along the straight undock the base disc "
         f"plus the navigation error ({undock}); at every station POI and the dock's POI the tray's "
-        f"turning circle plus the navigation stop error ({turning}).",
+        f"turning circle plus the navigation stop error ({turning}); the base disc plus the "
+        f"navigation error ({undock}) clear of the dock along every drive of the final approach "
+        "(from the POI to each working pose, and between the working poses).",
         "**Refused: a marker out of view**: from the POI and every working pose the head camera, aimed "
         f"at the marker, sees it {near:g} to {far:g} m away, at most "
         f"{service.MARKER_MAX_OBLIQUITY_DEG:g} deg off its face's normal and at least "

@@ -35,6 +35,7 @@ from functools import lru_cache
 import numpy as np
 
 from lab_description import station_placement as placement
+from lab_description.floor_gaps import bench_distance, bench_distances, closest, dock_distances, drive_points
 from tiago_description import robot_model
 from tiago_description import transforms as tf
 from tiago_description.hotel_model import hotel_sweep_radius
@@ -172,29 +173,6 @@ def service_problems(world) -> list[ServiceProblem]:  # noqa: ANN001 - a lab.wor
     return problems
 
 
-def bench_distance(station, x: float, y: float) -> float:  # noqa: ANN001
-    """Distance (m) from floor point (x, y) to the station's bench outline; negative inside it."""
-    return float(bench_distances(station, np.asarray(x, dtype=float), np.asarray(y, dtype=float)))
-
-
-def bench_distances(station, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:  # noqa: ANN001
-    """`bench_distance` for many floor points at once (a drive sampled every few centimetres)."""
-    pose = station.table_pose
-    c, s = math.cos(pose.yaw), math.sin(pose.yaw)
-    dx, dy = xs - pose.x, ys - pose.y
-    depth, width = station.table_size[0], station.table_size[1]
-    along = np.abs(c * dx + s * dy) - depth / 2
-    across = np.abs(-s * dx + c * dy) - width / 2
-    outside = np.hypot(np.maximum(along, 0.0), np.maximum(across, 0.0))
-    return np.where(outside > 0, outside, np.maximum(along, across))
-
-
-def drive_points(start, end, count: int) -> tuple[np.ndarray, np.ndarray]:  # noqa: ANN001 - Pose2D
-    """`count` + 1 floor points evenly along the straight drive from `start` to `end`, both ends in."""
-    k = np.arange(count + 1, dtype=float) / count
-    return start.x + (end.x - start.x) * k, start.y + (end.y - start.y) * k
-
-
 def _footprint_problems(world) -> Iterator[ServiceProblem]:  # noqa: ANN001
     dock_poses = (("the docked pose", world.dock_pose, BASE_RADIUS),)
     dock_poi = world.pois[world.dock_poi]
@@ -213,12 +191,11 @@ def _undock_problems(world, dock_poi) -> Iterator[str]:  # noqa: ANN001
     xs, ys = drive_points(world.dock_pose, dock_poi, 20)
     need = BASE_RADIUS + TURN_MARGIN
     for station in world.stations:
-        gaps = bench_distances(station, xs, ys)
-        nearest = int(np.argmin(gaps))
-        if gaps[nearest] < need:
+        gap, x, y = closest(bench_distances(station, xs, ys), xs, ys)
+        if gap < need:
             yield (
-                f"the undock drive from the docked pose to POI {world.dock_poi} passes {gaps[nearest]:.3f} m "
-                f"from bench {station.name!r} (at x {xs[nearest]:.3f} y {ys[nearest]:.3f} m); the base's "
+                f"the undock drive from the docked pose to POI {world.dock_poi} passes {gap:.3f} m "
+                f"from bench {station.name!r} (at x {x:.3f} y {y:.3f} m); the base's "
                 f"footprint and the navigation error need {need:.3f} m"
             )
 
@@ -269,10 +246,32 @@ def _station_problems(world, station) -> list[str]:  # noqa: ANN001
         problems += _clear(f"{station.name!r}: the base at POI {station.poi}", poi, turning, other)
         for label, working in working_poses(station):
             problems += _clear(f"{station.name!r}: the base at {label}", working, WORKING_CLEARANCE, other)
+    problems += list(_dock_problems(world, station))
     problems += _reach_problems(station)
     for label, pose in ((f"POI {station.poi}", poi), *working_poses(station)):
         problems += _view_problems(station, label, pose)
     return problems
+
+
+def _dock_problems(world, station) -> Iterator[str]:  # noqa: ANN001
+    """The final approach drives straight from the station's POI to the pose a nest is worked at from,
+    and from one such pose to the next: the base's footprint plus the navigation error must keep off
+    the dock all along (it stands lower than the tray and the folded arms). A pose moved along the
+    bench for an end nest has ended 0.17 m from the dock: the base drove into it, slid off, and swung
+    the tray into the bench."""
+    need = BASE_RADIUS + TURN_MARGIN
+    stops = [(f"POI {station.poi}", station.work_pose()), *working_poses(station)]
+    for i, (start_label, start) in enumerate(stops):
+        for end_label, end in stops[i + 1 :]:
+            xs, ys = drive_points(start, end, 10)
+            gap, x, y = closest(dock_distances(world.dock_pose, xs, ys), xs, ys)
+            if gap < need:
+                yield (
+                    f"{station.name!r}: the drive from {start_label} to {end_label} passes {gap:.3f} m "
+                    f"from the dock (at x {x:.3f} y {y:.3f} m); the base's footprint and the navigation "
+                    f"error need {need:.3f} m: move the dock or the station"
+                )
+                return  # one line per station: the dock stands where the robot works
 
 
 def _reach_problems(station, *, advise: bool = True) -> list[str]:  # noqa: ANN001

@@ -11,6 +11,8 @@ import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 
+from tiago_description.robot_model import BASE_RADIUS
+
 KEEP_CLEAR_M = 0.62
 """Free radius (m) around every POI, the docked pose and the working poses: the robot turns there,
 and its folded arms sweep 0.48 m from the base centre (navigation.planner.ARM_SWEEP_RADIUS_M;
@@ -19,6 +21,11 @@ may stop up to 9 cm off a POI along either axis (the navigation error: 3 cm per 
 campaign's default). At 0.55 m, a fridge 0.47 m from where a drive ended was either grazed by an
 arm or left no path (docs/explanation/decisions/room-around-the-robot.md)."""
 DOCK_PATH_SAMPLES = 5
+DOCK_GAP = 0.002
+"""Between the docked robot's rear and the dock's contact plate (m)."""
+DOCK_SIZE = (0.10, 0.45, 0.30)
+"""The charging dock's box (m): depth along the docked heading, width, height. It stands lower than
+the hotel tray's bottom (0.58 m) and the folded arms: only the base's footprint can meet it."""
 
 
 @dataclass(frozen=True)
@@ -171,3 +178,11 @@ def dock_path_points(
         )
         for k in range(1, DOCK_PATH_SAMPLES - 1)
     }
+
+
+def dock_box(docked) -> Obstacle:  # noqa: ANN001 - a world.Pose2D (world imports this module)
+    """The charging dock as a box on the floor: right behind the base of a robot docked at `docked`
+    (the physics scene builds it there, the map draws it, the loader keeps the robot's drives off it)."""
+    behind = BASE_RADIUS + DOCK_GAP + DOCK_SIZE[0] / 2
+    x, y = docked.x - behind * math.cos(docked.yaw), docked.y - behind * math.sin(docked.yaw)
+    return Obstacle("the dock", x, y, docked.yaw, DOCK_SIZE[0], DOCK_SIZE[1], height=DOCK_SIZE[2])

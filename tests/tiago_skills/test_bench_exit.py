@@ -26,6 +26,7 @@ def test_the_way_back_from_a_placed_plate_passes_clear_of_it(tmp_path: Path) -> 
     logs = tmp_path / "logs"
     replay = ("--replay", "208108", "--json", "--log-dir", str(logs), "--verbose")
     done = run_bench("--world", str(FIXTURE), *replay)
+    assert (logs / "sim_node.log").exists(), f"the robot side did not start:\n{done.stderr[-3000:]}"
     skills_log = (logs / "sim_node.log").read_text()
     after = skills_log.split("no straight way back from over the bench", 1)
     assert len(after) == 2, "the straight line back was found: the fixture lost its point"

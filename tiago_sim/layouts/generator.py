@@ -29,14 +29,12 @@ import random
 from dataclasses import dataclass
 from typing import Any
 
+from lab_description import world_obstacles
+from lab_description.floor_gaps import bench_distance, bench_distances, drive_points
 from lab_description.serviceability import (
-    BASE_RADIUS,
     HOTEL_SWEEP_RADIUS,
     TURN_MARGIN,
     WORKING_CLEARANCE,
-    bench_distance,
-    bench_distances,
-    drive_points,
     station_alone_problems,
     working_poses,
 )
@@ -61,10 +59,6 @@ PLACEMENT_TRIES = 300  # per station, before the whole floor is drawn again
 LAYOUT_TRIES = 50
 
 
-DOCK_BOX = (0.10, 0.45)  # m, the dock's footprint (tiago_sim.physics.scene.DOCK_SIZE)
-DOCK_BOX_BEHIND = BASE_RADIUS + 0.002 + DOCK_BOX[0] / 2  # its centre behind the docked base's centre
-
-
 @dataclass(frozen=True)
 class _Box:
     """An obstacle's outline as `bench_distance` reads a station's: pose of its centre, depth, width."""
@@ -76,10 +70,8 @@ class _Box:
 def dock_box(world: World) -> _Box:
     """The dock's outline on the floor: a straight drive must keep off it as off a bench (a drive from
     the dock's POI back past the dock ran the robot into it)."""
-    pose = world.dock_pose
-    x = pose.x - DOCK_BOX_BEHIND * math.cos(pose.yaw)
-    y = pose.y - DOCK_BOX_BEHIND * math.sin(pose.yaw)
-    return _Box(Pose2D(x, y, pose.yaw), (*DOCK_BOX, 0.0))
+    dock = world_obstacles.dock_box(world.dock_pose)
+    return _Box(Pose2D(dock.x, dock.y, dock.yaw), (dock.length, dock.width, dock.height))
 
 
 class LayoutError(RuntimeError):

@@ -14,12 +14,10 @@ import cv2
 import numpy as np
 
 from lab_description.world import MARKER_BOARD_SCALE, World
-from tiago_description.robot_model import BASE_RADIUS
+from lab_description.world_obstacles import DOCK_SIZE, dock_box
 
 DEFAULT_RESOLUTION = 0.05  # m per cell (the ROS 2 navigation stack's usual resolution)
 WALL_THICKNESS = 0.10  # m: the floor's edge is a wall this thick, inside the floor
-DOCK_GAP = 0.002  # m between the docked robot's rear and the dock's contact plate
-DOCK_SIZE = (0.10, 0.45, 0.30)  # m: depth (along the docked heading), width, height
 BOARD_BAND = 0.04  # m: a marker board (1 cm thick, 6 mm behind the marker) as a strip on the map
 
 
@@ -118,11 +116,8 @@ def obstacle_footprints(world: World, above_m: float = 0.0) -> list[Footprint]:
 
 def dock_footprint(world: World) -> Footprint:
     """The charging dock's outline: behind the docked robot (physics.scene builds it there)."""
-    dock = world.dock_pose
-    behind = BASE_RADIUS + DOCK_GAP + DOCK_SIZE[0] / 2
-    return Footprint(
-        dock.x - behind * math.cos(dock.yaw), dock.y - behind * math.sin(dock.yaw), dock.yaw, *DOCK_SIZE[:2]
-    )
+    dock = dock_box(world.dock_pose)
+    return Footprint(dock.x, dock.y, dock.yaw, dock.length, dock.width)
 
 
 def build_map(world: World, resolution: float = DEFAULT_RESOLUTION, above_m: float = 0.0) -> OccupancyMap:

@@ -5,7 +5,7 @@ from driving through a bench; the arm may graze a bench top or a nest bracket. A
 bumpers and motor-current monitors notice; here PyBullet's contact points after every step do.
 Every robot link counts (base, wheels, torso, head, arms, grippers, the hotel tray). What it may
 touch: plates (grasping, carrying and setting them down touch them by design), the floor, and the
-dock with the base while docking (the contact plate closes the charging circuit). Everything else
+dock with the base's back (its contact plate closes the charging circuit). Everything else
 - a bench (its table), a nest bracket, a marker stand, a free-standing obstacle, a wall - is an
 unintended contact: it is reported once when it starts (a link and a thing touching for many steps
 is one collision), with the depth at its deepest first step.
@@ -32,6 +32,10 @@ TOUCH_DISTANCE_M = 0.0
 reports points up to its contact-breaking threshold (2 cm) apart, which are not touches."""
 DOCK_LINKS = frozenset({"base_footprint", "base_link"})
 """The robot links that touch the dock by design."""
+DOCK_CONTACT_HALF_ANGLE = math.radians(45.0)
+"""The charging contacts are on the base's back: the base touches the dock by design within this of
+straight behind it (docking ends a few degrees off at most); its front or side meeting the dock is a
+collision (a final approach drove the base's side into it, and it was not reported)."""
 NEAR_MISS_M = 0.01
 """Closer than this without touching is a near miss: logged (INFO) with the closest approach per
 link and thing, so a run's log says how much room the arm and base really had. Bullet's contact
@@ -105,7 +109,7 @@ class CollisionWatch:
             for point in p.getClosestPoints(self.robot.id, body, NEAR_MISS_M, physicsClientId=self.client):
                 link, distance = point[3], point[8]
                 if distance <= TOUCH_DISTANCE_M or (
-                    body == self.dock and self.link_names.get(link) in DOCK_LINKS
+                    body == self.dock and self._charging_contact(link, point[5])
                 ):
                     continue
                 key = (self._link_name(link, point[5]), thing)
@@ -121,13 +125,21 @@ class CollisionWatch:
             )
         return name
 
+    def _charging_contact(self, link: int, position: tuple[float, float, float]) -> bool:
+        """A base contact with the dock behind the base, below its top: where the charging contacts are."""
+        if self.link_names.get(link, "") not in DOCK_LINKS or position[2] > BASE_TOP_M:
+            return False
+        x, y, yaw = self.robot.base_xy_yaw()
+        bearing = math.atan2(position[1] - y, position[0] - x) - yaw
+        return abs(math.atan2(math.sin(bearing), -math.cos(bearing))) <= DOCK_CONTACT_HALF_ANGLE
+
     def check(self, sim_time: float) -> list[Collision]:
         """The unintended contacts that started in the last step (each also kept in ``collisions``)."""
         deepest: dict[tuple[int, int], tuple[float, tuple[float, float, float]]] = {}
         self.points = p.getContactPoints(bodyA=self.robot.id, physicsClientId=self.client)
         for point in self.points:
             body, link, distance = point[2], point[3], point[8]
-            if body not in self.things or (body == self.dock and self.link_names.get(link, "") in DOCK_LINKS):
+            if body not in self.things or (body == self.dock and self._charging_contact(link, point[5])):
                 continue
             if distance > TOUCH_DISTANCE_M:
                 continue

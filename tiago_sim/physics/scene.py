@@ -17,12 +17,12 @@ import numpy as np
 import pybullet as p
 
 from lab_description.world import Obstacle, Station, World
+from lab_description.world_obstacles import DOCK_SIZE, dock_box
 from labware_model.holders import HotelSlot, Nest
 from labware_model.labware import LabwareType
 from tiago_description import transforms as tf
 from tiago_description.hotel_model import corner_ramp_boxes
-from tiago_description.robot_model import BASE_RADIUS
-from tiago_sim.navigation.occupancy_map import DOCK_GAP, DOCK_SIZE, WALL_THICKNESS
+from tiago_sim.navigation.occupancy_map import WALL_THICKNESS
 from tiago_sim.physics.gridded_box import GRID_CELL, gridded_box_visual
 from tiago_sim.physics.marker_asset import marker_visual
 
@@ -245,9 +245,8 @@ def build_scene(client: int, world: World, T_world_hotel_slots: dict[int, np.nda
         _build_nests(client, station, default_type, scene)
     for station in world.stations:
         _build_table(client, station, scene)
-    T_world_dock = world.dock_pose.matrix() @ tf.make_transform(
-        (-(BASE_RADIUS + DOCK_GAP + DOCK_SIZE[0] / 2), 0, DOCK_SIZE[2] / 2)
-    )
+    dock = dock_box(world.dock_pose)
+    T_world_dock = tf.from_planar(dock.x, dock.y, dock.yaw, DOCK_SIZE[2] / 2)
     scene.dock = _static_box(client, DOCK_SIZE, T_world_dock, [0.2, 0.3, 0.2, 1])
     scene.obstacles = {obstacle.name: _obstacle_body(client, obstacle) for obstacle in world.obstacles}
     scene.walls = _build_walls(client, world.floor_size)

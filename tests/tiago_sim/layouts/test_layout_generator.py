@@ -10,22 +10,15 @@ import sys
 from functools import cache
 from pathlib import Path
 
-import pytest
 import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from lab_description.serviceability import bench_distance
+from lab_description.floor_gaps import dock_distances, drive_points
 from lab_description.world import load_world, world_from_raw
 from labware_model.holders import Nest
 from tiago_sim.inspection.world_check import INVALID_WORLD_EXIT_CODE, check_world
-from tiago_sim.layouts.generator import (
-    DOCK_BOX,
-    DOCK_BOX_BEHIND,
-    dock_box,
-    generate_layout,
-    route_problems,
-)
+from tiago_sim.layouts.generator import generate_layout, route_problems
 from tiago_sim.layouts.layout_file import layout_yaml
 from tiago_sim.layouts.station_draw import LABWARE_TYPES, RANGES
 
@@ -98,21 +91,14 @@ def test_the_command_writes_a_layout_file_that_loads(tmp_path: Path) -> None:
     assert load_world(target).name == "random layout 11"
 
 
-def test_the_dock_outline_is_the_scenes_dock_and_no_drive_between_pois_crosses_it() -> None:
-    from tiago_sim.physics import scene  # the test may look at the simulation; the generator may not
-
-    assert DOCK_BOX == scene.DOCK_SIZE[:2]
-    assert DOCK_BOX_BEHIND == pytest.approx(scene.BASE_RADIUS + scene.DOCK_GAP + scene.DOCK_SIZE[0] / 2)
+def test_no_drive_between_pois_crosses_the_dock() -> None:
     for seed in (80006, *range(10)):  # 80006 drove through its dock before this rule (a22f3cf)
         world = world_from_raw(drawn(seed), f"layout seed {seed}")
         points = [world.pois[world.dock_poi], *(station.work_pose() for station in world.stations)]
-        box = dock_box(world)
         for i, start in enumerate(points):
             for end in points[i + 1 :]:
-                steps = 40
-                dx, dy = (end.x - start.x) / steps, (end.y - start.y) / steps
-                gaps = [bench_distance(box, start.x + dx * k, start.y + dy * k) for k in range(steps + 1)]
-                assert min(gaps) >= 0.40 - 0.01, (seed, start, end)
+                gaps = dock_distances(world.dock_pose, *drive_points(start, end, 40))
+                assert gaps.min() >= 0.40 - 0.01, (seed, start, end)
 
 
 def test_a_poi_the_planner_cannot_reach_once_navigation_stops_off_it_is_drawn_again() -> None:
@@ -141,6 +127,21 @@ def test_a_working_pose_moved_along_the_bench_that_the_robot_could_not_leave_is_
     out, err = io.StringIO(), io.StringIO()
     assert check_world(kept, None, out, err) == INVALID_WORLD_EXIT_CODE
     assert err.getvalue().splitlines() == [line.replace("layout:", f"{kept}:", 1) for line in problems]
+
+
+def test_a_working_pose_whose_final_approach_passes_the_dock_is_refused() -> None:
+    """Random layout 212010 (kept from the campaign at d184587): the sealer's nest 4 was worked at from
+    a pose moved along the bench to 0.16 m from the dock. The final approach drove the base into the
+    dock, which counted as docking, and then the tray into the bench (COLLISION). The loader now keeps
+    every drive of the final approach off the dock."""
+    kept = FIXTURES / "layout_212010.yaml"
+    out, err = io.StringIO(), io.StringIO()
+    assert check_world(kept, None, out, err) == INVALID_WORLD_EXIT_CODE
+    assert err.getvalue().splitlines() == [
+        f"{kept}: stations[0]: 'sealer': the drive from POI sealer_work to the working pose for nest 4 "
+        "passes 0.159 m from the dock (at x -0.724 y 0.293 m); the base's footprint and the navigation "
+        "error need 0.315 m: move the dock or the station"
+    ]
 
 
 def test_the_robot_leaves_a_working_pose_beside_a_corner_its_folded_arm_clears() -> None:

@@ -1,5 +1,5 @@
-"""Collision honesty in real PyBullet: a drive through a bench is stopped and named; a drive around
-it, and docking, touch nothing they should not."""
+"""Collision honesty in real PyBullet: a drive through a bench, or into the dock front first, is
+stopped and named; a drive around the bench, and docking, touch nothing they should not."""
 
 from __future__ import annotations
 
@@ -65,6 +65,19 @@ def test_a_straight_drive_through_the_bench_is_stopped_as_a_collision(
     x, y, _ = sim.robot.base_xy_yaw()
     assert bench.distance_to(x, y) > 0.15, "the base centre went on into the bench"
     assert sim.base.stopped()
+
+
+def test_the_base_driving_into_the_dock_front_first_is_a_collision() -> None:
+    """The base touches the dock by design with its back only (the charging contacts): a drive back
+    to the docked pose facing the dock meets it with the base's front and is stopped as a collision."""
+    world = load_world(DEFAULT_WORLD)
+    sim = Simulation(world, seed=2)
+    assert sim.run(sim.undock()).success
+    dock = world.dock_pose
+    motion = sim.run(sim.drive_to(dock.x, dock.y, dock.yaw + math.pi, speed=0.1))
+    sim.close()
+    assert not motion.success and motion.error_code == COLLISION, motion.message
+    assert "the base (base_footprint) touched the dock" in motion.message
 
 
 def test_the_travel_pose_sweeps_no_farther_than_the_planners_robot_radius() -> None:
