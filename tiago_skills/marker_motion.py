@@ -46,6 +46,7 @@ from tiago_skills.behaviours import (
 )
 from tiago_skills.bench_exit import BenchExit
 from tiago_skills.bench_route import BenchRoute, held_plate_box, largest_labware
+from tiago_skills.gaze import marker_and_held_plate
 from tiago_skills.goal_run import ActionAbort, GoalRun
 from tiago_skills.joint_commands import move_joints
 from tiago_skills.marker_sighting import MarkerSighting, pose_msg, same_place
@@ -103,6 +104,7 @@ class MarkerMotionBehaviour:
             tuple(frame.odometry),
             observation.reprojection_error_px,
             dict(frame.joints),
+            frame.intrinsics,
         )
         log.info(
             "marker %d of %s at %s in base, quaternion %s (reprojection %.2f px)",
@@ -222,17 +224,19 @@ class MarkerMotionBehaviour:
         """The site (``site_seen`` of a marker sighting) moved by the shift that centres the held
         plate on it (as it is without a measurement), and the sighting it was taken with. Taken from
         where the tool stands now, above the nest after the approach. When the head has moved since
-        the marker's sighting or the plate is not seen whole (an end out of the image: random layout
-        191031), the head is aimed between the marker and the tool, and marker and plate are seen
-        again with that one gaze."""
+        the marker's sighting or the plate is not seen whole (an end out of the image: random layouts
+        191031, 211038), the head is turned to frame the marker and the plate's outline together
+        (`gaze`), and both are seen again with that one gaze."""
         T_base_site = site_seen(sighting)
         shift, why = self._shift(run, arm, T_base_site, sighting)
         if shift is None and why in LOOK_AGAIN:
             joints = run.read(lambda hardware: dict(hardware.joint_positions()))
             tool = self.behaviours.planning.tool_pose(arm, joints)[:3, 3]
-            between = (sighting.T_base_marker[:3, 3] + tool) / 2.0
-            log.info("looking again with marker and held plate in one view (%s)", why)
-            aim = within_head_limits(head_angles_towards(self.kinematics, joints, between))
+            aim, fits = marker_and_held_plate(
+                self.kinematics, joints, sighting, self.world, T_base_site, tool
+            )
+            log.info("looking again with marker and held plate in one view (%s)%s", why, "" if fits else
+                     ": they do not fit in it whole")  # fmt: skip
             run.follow(move_joints(aim), span=(0.0, 0.1))
             try:
                 sighting = self.look(run, sighting.station)

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from geometry_msgs.msg import Pose
 
+from robot_port.types import CameraIntrinsics
 from tiago_description import transforms as tf
 
 # A cached marker stays valid while odometry moved less than this.
@@ -28,6 +29,7 @@ class MarkerSighting:
     odometry: tuple[float, float, float]
     reprojection_error_px: float
     joints: dict[str, float] = field(default_factory=dict)  # readings taken with the image
+    intrinsics: CameraIntrinsics = field(default_factory=CameraIntrinsics)  # the image's camera
 
 
 def same_place(then: tuple[float, float, float], now: tuple[float, float, float]) -> bool:

@@ -2,8 +2,11 @@
 
 Random layout 191031 (campaign seed 191000 at 89e359f): above reader/1 the held plate ran out of the
 head image's edge at the gaze that had seen the marker, the place correction measured nothing, and
-the plate went down uncorrected onto the nest's brackets (PLACE_FAILED). The skills now aim the head
-between the marker and the tool, see both again with that one gaze, and place the plate measured.
+the plate went down uncorrected onto the nest's brackets (PLACE_FAILED). The skills then aimed the
+head between the marker and the tool and saw both again with that one gaze. Random layout 211038
+(campaign seed 211000 at d184587): above storage/1, 0.59 m right of the base and 0.9 m high, that
+gaze still left the plate's outer end past the image's corner, and the place failed the same way.
+The head now frames the marker's and the plate's outlines together (`tiago_skills.gaze`).
 
 (What the skills do when a measured place lies beyond the arm's reach: test_reachable.py.)
 
@@ -16,6 +19,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
+
 from tests.sila_labware.benchmarks.test_bench import run_bench
 
 FIXTURES = Path(__file__).parent / "fixtures"
@@ -23,10 +28,16 @@ LOOKED_AGAIN = "looking again with marker and held plate in one view"
 MEASURED = "held plate at ("
 
 
-def test_a_plate_half_out_of_the_image_is_seen_again_and_placed(tmp_path: Path) -> None:
+@pytest.mark.parametrize(
+    ("fixture", "seed"),
+    [("plate_beyond_the_image_edge.yaml", "191031"), ("plate_beyond_the_image_corner.yaml", "211038")],
+)
+def test_a_plate_half_out_of_the_image_is_seen_again_and_placed(
+    tmp_path: Path, fixture: str, seed: str
+) -> None:
     logs = tmp_path / "logs"
-    world = str(FIXTURES / "plate_beyond_the_image_edge.yaml")
-    done = run_bench("--world", world, "--replay", "191031", "--json", "--log-dir", str(logs), "--verbose")
+    world = str(FIXTURES / fixture)
+    done = run_bench("--world", world, "--replay", seed, "--json", "--log-dir", str(logs), "--verbose")
     skills_log = (logs / "sim_node.log").read_text()
     first, _, after = skills_log.partition(LOOKED_AGAIN)
     assert after, "the plate was seen whole at the first gaze: the fixture lost its point"
