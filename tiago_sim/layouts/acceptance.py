@@ -62,7 +62,7 @@ def reason_kind(problem: str) -> str:
         return "a nest out of reach"
     if "cannot see marker" in problem:
         return "a marker out of view"
-    if re.search(r"m from bench|the undock drive", problem):
+    if re.search(r"m from bench|the undock drive|m from the dock", problem):
         return "no room for the base"
     return "other"
 

@@ -26,3 +26,9 @@ def test_a_lab_the_loader_accepts_but_the_robot_cannot_leave_is_refused_for_its_
 
 def test_a_lab_the_robot_serves_and_drives_is_accepted() -> None:
     assert check_lab(207020, _raw("layout_207020.yaml")).accepted
+
+
+def test_a_final_approach_past_the_dock_is_refused_as_no_room_for_the_base() -> None:
+    verdict = check_lab(212010, _raw("layout_212010.yaml"))
+    assert not verdict.accepted
+    assert [reason_kind(problem) for problem in verdict.problems] == ["no room for the base"]
