@@ -36,6 +36,7 @@ import numpy as np
 
 from lab_description import station_placement as placement
 from lab_description.floor_gaps import bench_distance, bench_distances, closest, dock_distances, drive_points
+from lab_description.station_placement import working_poses
 from tiago_description import robot_model
 from tiago_description import transforms as tf
 from tiago_description.hotel_model import hotel_sweep_radius
@@ -213,18 +214,6 @@ def _clear(label: str, pose, radius: float, station) -> Iterator[str]:  # noqa: 
         )
 
 
-def working_poses(station) -> list[tuple[str, object]]:  # noqa: ANN001
-    """The station's working pose and every other pose a nest is worked at from (`nest_working_pose`),
-    each with how the messages name it."""
-    working = station.aligned_pose()
-    poses: list[tuple[str, object]] = [("the working pose", working)]
-    for sub_position, T_world_base in placement.nest_working_poses(station):
-        x, y, yaw = float(T_world_base[0, 3]), float(T_world_base[1, 3]), working.yaw
-        if math.hypot(x - working.x, y - working.y) > 1e-6:
-            poses.append((f"the working pose for nest {sub_position}", type(working)(x, y, yaw)))
-    return poses
-
-
 def station_alone_problems(station, *, advise: bool = True) -> list[str]:  # noqa: ANN001
     """The station's own reasons the robot cannot serve it, whatever else stands in the lab: its nests
     out of reach, its marker out of view, a working pose too near its own bench (a layout generator's
@@ -257,7 +246,7 @@ def _dock_problems(world, station) -> Iterator[str]:  # noqa: ANN001
     """The final approach drives straight from the station's POI to the pose a nest is worked at from,
     and from one such pose to the next: the base's footprint plus the navigation error must keep off
     the dock all along (it stands lower than the tray and the folded arms). A pose moved along the
-    bench for an end nest has ended 0.17 m from the dock: the base drove into it, slid off, and swung
+    bench for an end nest has ended 0.16 m from the dock: the base drove into it, slid off, and swung
     the tray into the bench."""
     need = BASE_RADIUS + TURN_MARGIN
     stops = [(f"POI {station.poi}", station.work_pose()), *working_poses(station)]

@@ -142,3 +142,15 @@ def nest_working_pose(station, sub_position: int, arm: str) -> np.ndarray:  # no
 def nest_working_poses(station, arm: str = REACH_ARM) -> list[tuple[int, np.ndarray]]:  # noqa: ANN001
     """Every nest with the pose it is worked at from (`nest_working_pose`), sub-position 1 first."""
     return [(n, nest_working_pose(station, n, arm)) for n in range(1, station.sub_positions + 1)]
+
+
+def working_poses(station) -> list[tuple[str, object]]:  # noqa: ANN001
+    """The station's working pose and every other pose a nest is worked at from (`nest_working_pose`),
+    each with how the messages name it."""
+    working = station.aligned_pose()
+    poses: list[tuple[str, object]] = [("the working pose", working)]
+    for sub_position, T_world_base in nest_working_poses(station):
+        x, y, yaw = float(T_world_base[0, 3]), float(T_world_base[1, 3]), working.yaw
+        if math.hypot(x - working.x, y - working.y) > 1e-6:
+            poses.append((f"the working pose for nest {sub_position}", type(working)(x, y, yaw)))
+    return poses

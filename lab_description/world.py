@@ -26,7 +26,7 @@ import numpy as np
 import yaml
 
 from lab_description import world_schema as schema
-from lab_description.station_placement import nest_working_poses
+from lab_description.station_placement import working_poses
 from lab_description.world_obstacles import (
     Bench,
     Obstacle,
@@ -281,12 +281,8 @@ def _obstacle_placement_problems(world: World) -> list[tuple[str, str]]:
     dock_poi = world.pois[world.dock_poi]
     keep_clear.update(dock_path_points((world.dock_pose.x, world.dock_pose.y), (dock_poi.x, dock_poi.y)))
     for station in world.stations:
-        aligned = station.aligned_pose()
-        keep_clear[f"{station.name}'s working pose"] = (aligned.x, aligned.y)
-        for sub_position, T_world_base in nest_working_poses(station):
-            x, y = float(T_world_base[0, 3]), float(T_world_base[1, 3])
-            if math.hypot(x - aligned.x, y - aligned.y) > 1e-6:
-                keep_clear[f"{station.name}'s working pose for nest {sub_position}"] = (x, y)
+        for label, pose in working_poses(station):
+            keep_clear[f"{station.name}'s {label.removeprefix('the ')}"] = (pose.x, pose.y)
     return placement_problems(world.obstacles, world.floor_size, _benches(world), keep_clear)
 
 

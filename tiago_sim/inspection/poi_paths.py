@@ -14,7 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from itertools import combinations
 
-from lab_description.serviceability import working_poses
+from lab_description.station_placement import working_poses
 from lab_description.world import World
 from tiago_sim.navigation.planner import GlobalPlanner, Plan, PlanningError, world_planner
 

@@ -36,8 +36,8 @@ from lab_description.serviceability import (
     TURN_MARGIN,
     WORKING_CLEARANCE,
     station_alone_problems,
-    working_poses,
 )
+from lab_description.station_placement import working_poses
 from lab_description.world import Pose2D, Station, World, WorldError, station_from_raw, world_from_raw
 from lab_description.world_schema import MARKER_DICTIONARY_SIZE, MIRROR_AMBIGUOUS_MARKER_IDS
 from tiago_sim.inspection.poi_paths import plan_poi_paths
