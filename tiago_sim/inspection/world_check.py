@@ -14,6 +14,7 @@ Exit codes: 0 valid, 1 invalid (every problem on stderr, one per line: `file: fi
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -22,8 +23,12 @@ from typing import TextIO
 from lab_description.world import World, WorldError, load_world
 from labware_model.holders import HotelSlot, Nest
 from tiago_sim.inspection.poi_paths import PoiPaths, plan_poi_paths
+from tiago_sim.inspection.reach_sweep import SWEEP_TERMS, sweep_nest
 
 INVALID_WORLD_EXIT_CODE = 1
+_REACH_OR_VIEW = re.compile(
+    r"'([^']+)': (?:nest \d+ is out of the \w+ arm's reach|the head camera cannot see)"
+)
 
 
 def _paths_line(paths: PoiPaths) -> str:
@@ -101,6 +106,7 @@ def check_world(path: Path, png: Path | None, out: TextIO, err: TextIO) -> int:
         world = load_world(path)
     except WorldError as error:
         err.write("".join(f"{line}\n" for line in error.problems))
+        out.write(_swept(path, error.problems))
         return INVALID_WORLD_EXIT_CODE
     paths = plan_poi_paths(world)
     out.write(summary(world, paths))
@@ -112,6 +118,30 @@ def check_world(path: Path, png: Path | None, out: TextIO, err: TextIO) -> int:
     problems = paths.problems(str(path))
     err.write("".join(f"{line}\n" for line in problems))
     return INVALID_WORLD_EXIT_CODE if problems else 0
+
+
+def _swept(path: Path, problems: Sequence[str]) -> str:
+    """For a station refused for its reach or its marker's view: whether any base pose the floor
+    allows would reach its nests (`reach_sweep`). It tells an integrator whether the arm cannot reach
+    a nest at all (lower it, or bring it forward) or the robot's choice of where to stand refused it."""
+    named = {match.group(1) for match in map(_REACH_OR_VIEW.search, problems) if match}
+    if not named:
+        return ""
+    try:
+        world = load_world(path, check_robot=False)
+    except WorldError:  # the file's own rules fail too: nothing to sweep
+        return ""
+    lines = [f"reach sweep ({SWEEP_TERMS}):"]
+    for index, station in enumerate(world.stations):
+        if station.name not in named:
+            continue
+        reaches = [sweep_nest(world, index, nest) for nest in range(1, station.sub_positions + 1)]
+        short = [reach for reach in reaches if reach.not_served]
+        lines += [f"  {reach.line()}" for reach in short] or [
+            f"  {station.name}: every nest serves every labware type from some pose; the pose the robot "
+            "chose to work from is what the refusal is about"
+        ]
+    return "\n".join(lines) + "\n"
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 from lab_description.world import WorldError, world_from_raw
 from tiago_sim.inspection.poi_paths import plan_poi_paths
+from tiago_sim.inspection.reach_sweep import NestReach, sweep_world, unserved
 from tiago_sim.layouts.generator import draw_floor_plan
 
 
@@ -54,6 +55,28 @@ def check_lab(seed: int, raw: dict) -> Verdict:
     return Verdict(seed, raw, tuple(plan_poi_paths(world).problems(source)))
 
 
+@dataclass(frozen=True)
+class Confirmation:
+    """A refused lab against the reach sweep: the nests no pose serves for the lab's tallest labware
+    type (the refusal is confirmed when there is one), and those that serve no type at all."""
+
+    tallest: tuple[NestReach, ...]
+    any_type: tuple[NestReach, ...]
+
+    @property
+    def confirmed(self) -> bool:
+        return bool(self.tallest)
+
+
+def confirm(verdict: Verdict) -> Confirmation:
+    """Sweep a refused lab's nests (`reach_sweep`) with its floor plan alone."""
+    world = world_from_raw(verdict.raw, f"furniture lab {verdict.seed}", check_robot=False)
+    tallest = max(world.labware_types, key=lambda name: world.labware_types[name].height)
+    reaches = sweep_world(world)
+    every_type = list(world.labware_types)
+    return Confirmation(tuple(unserved(reaches, [tallest])), tuple(unserved(reaches, every_type)))
+
+
 def reason_kind(problem: str) -> str:
     """A refusal's kind: reach, view, base (footprint or turning room), the robot's ways, or other."""
     if re.search(r"no path for the robot|could not leave", problem):
@@ -75,16 +98,34 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("count", type=int)
     args = parser.parse_args(argv)
     kinds: Counter[str] = Counter()
-    accepted = 0
+    unconfirmed: Counter[str] = Counter()
+    accepted = confirmed = any_type = 0
     for seed in range(args.first, args.first + args.count):
         verdict = check_seed(seed)
         accepted += verdict.accepted
-        kinds.update({reason_kind(problem) for problem in verdict.problems})
-        if not verdict.accepted:
-            sys.stdout.write(f"{seed}: refused: {verdict.problems[0]}\n")
+        reasons = {reason_kind(problem) for problem in verdict.problems}
+        kinds.update(reasons)
+        if verdict.accepted:
+            continue
+        sys.stdout.write(f"{seed}: refused: {verdict.problems[0]}\n")
+        sweep = confirm(verdict)
+        confirmed += sweep.confirmed
+        any_type += bool(sweep.any_type)
+        if sweep.confirmed:
+            sys.stdout.write(f"  confirmed by the reach sweep: {sweep.tallest[0].line()}\n")
+        else:
+            unconfirmed.update(reasons)
+            sys.stdout.write("  not confirmed: the reach sweep serves every nest from some pose\n")
+    refused = args.count - accepted
     sys.stdout.write(f"accepted {accepted} of {args.count} labs ({100.0 * accepted / args.count:.1f} %)\n")
     for kind, count in kinds.most_common():
         sys.stdout.write(f"  refused for {kind}: {count}\n")
+    sys.stdout.write(
+        f"refusals confirmed by the reach sweep: {confirmed} of {refused} (a nest no base pose serves with "
+        f"the tallest labware type; {any_type} with no type at all)\n"
+    )
+    for kind, count in unconfirmed.most_common():
+        sys.stdout.write(f"  not confirmed, refused for {kind}: {count}\n")
     return 0
 
 

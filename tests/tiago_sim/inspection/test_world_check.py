@@ -106,3 +106,37 @@ def test_planned_paths_keep_the_turning_circle_off_benches_and_obstacles() -> No
         first, last = path.plan.waypoints[0], path.plan.waypoints[-1]
         start, goal = world.pois[path.start], world.pois[path.goal]
         assert math.dist(first, (start.x, start.y)) < 1e-6 and math.dist(last, (goal.x, goal.y)) < 1e-6
+
+
+def test_a_refused_bench_is_swept_for_the_integrator_naming_the_labware_it_could_serve(
+    tmp_path: Path,
+) -> None:
+    """The default lab's benches raised to 0.93 m, deep-well plates declared and no robot field: the
+    loader refuses every nest for its approach over a deep-well plate; the sweep that follows on stdout
+    says a microplate would be served, and from where. A refusal for the view alone is said to be the
+    robot's choice of where to stand, not the reach."""
+    raw = yaml.safe_load(SCHEMA_FILE.parent.joinpath("default.yaml").read_text())
+    deepwell = {"length": 0.12776, "width": 0.08548, "height": 0.0441, "mass": 0.45}
+    raw["labware_types"]["sbs_deepwell_96"] = deepwell
+    for station in raw["stations"]:
+        station["table"]["size"][2] = 0.93
+        for field in ("standoff", "work_standoff", "lateral"):
+            station["poi"].pop(field)
+        station["nests"].pop("approach_height")
+    path = tmp_path / "standing.yaml"
+    path.write_text(yaml.safe_dump(raw))
+    out, err = io.StringIO(), io.StringIO()
+    assert check_world(path, None, out, err) == 1
+    assert len(err.getvalue().splitlines()) == 4 and "out of the right arm's reach" in err.getvalue()
+    swept = out.getvalue().splitlines()
+    assert swept[0].startswith("reach sweep (top-down grasps")
+    assert len(swept) == 5
+    for line in swept[1:]:
+        assert "(0.930 m): serves sbs_microplate_96, not sbs_deepwell_96; best from" in line
+    view_only = Path(__file__).parents[1] / "layouts" / "fixtures" / "furniture_lab_130003.yaml"
+    out = io.StringIO()
+    assert check_world(view_only, None, out, io.StringIO()) == 1
+    assert out.getvalue().splitlines()[1] == (
+        "  centrifuge: every nest serves every labware type from some pose; the pose the robot chose "
+        "to work from is what the refusal is about"
+    )
