@@ -30,7 +30,7 @@ from sila_labware.benchmarks.levels import levels_json
 from sila_labware.benchmarks.stop_deadline import stop_within
 from sila_labware.client import remaining_time
 from sila_labware.client.remaining_time import RemainingCheck
-from sila_labware.deployment.demo import MISPLACED, DemoReport, run_demo
+from sila_labware.deployment.demo import DISTURBED, MISPLACED, DemoReport, run_demo
 from sila_labware.deployment.processes import interrupt_requested
 from sila_labware.deployment.stack import Deployment, DeploymentOptions
 
@@ -58,6 +58,8 @@ BASE_MOTION_WORDS = ("driving to", "Dock", "Undock")
 def classify_failure(report: DemoReport) -> str:
     """Failure cause of one trial from what the SiLA commands and the placement check said."""
     error = report.error
+    if error.startswith(DISTURBED):  # another plate knocked out of place: an unintended contact
+        return "collision"
     if error.startswith(MISPLACED):  # the commands succeeded, the physics check disagrees
         return "positioning"
     for code, cause in CAUSE_BY_ERROR_CODE.items():

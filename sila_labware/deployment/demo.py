@@ -5,8 +5,10 @@ Moves the plate found on the first station to a free nest of the second through
 Robot.PrepareForInput, Robot.GetLabware, A.LabwareRemoved, B.PrepareForInput +
 Robot.PrepareForOutput, Robot.PutLabware, B.LabwareDelivered). Each step is timed in wall and
 simulated seconds (the robot's /robot_state stamp, read through the bridge). Success is judged from
-physics ground truth (/check_placement through the bridge), never from what the commands reported;
-a check that gets no answer makes the run a failure with that error, never a crash.
+physics ground truth (/check_placement through the bridge), never from what the commands reported:
+the plate rests in its destination nest, and every other plate of the world file that rested where
+the file puts it still does (`bystanders`). A check that gets no answer makes the run a failure with
+that error, never a crash.
 
 Threads: runs on the caller's thread, where the client also calls back with progress; sila2's
 client threads deliver execution infos.
@@ -28,6 +30,7 @@ from ros_bridge.robot_link import RobotLink
 from sila_labware.client import StepProgress
 from sila_labware.client.console import ProgressLine
 from sila_labware.client.remaining_time import RemainingCheck, RemainingSampler
+from sila_labware.deployment.bystanders import bystanders_in_place, moved_bystanders
 from sila_labware.deployment.clients import transfer_client
 from sila_labware.deployment.plate_names import plate_named_at
 from sila_labware.deployment.stack import Deployment
@@ -117,6 +120,12 @@ def run_demo(deployment: Deployment, progress_stream: TextIO | None = sys.stderr
     report.source = str(plate_nest)
     report.destination = str(free_nest)
 
+    try:  # the other plates, as physics finds them before the transfer (bystanders)
+        before = bystanders_in_place(link, deployment.options.world, plate_id, plate_nest)
+    except BridgeError as error:
+        report.error = f"physics check failed: no answer from the robot side: {error}"
+        return report
+
     clock = StepClock(link, ProgressLine(progress_stream))
     wall_start, sim_start = time.monotonic(), link.robot_status().stamp_s
     try:
@@ -141,6 +150,7 @@ def run_demo(deployment: Deployment, progress_stream: TextIO | None = sys.stderr
         plate_id = plate_to_judge(link, plate_id, free_nest)
         report.labware_id = plate_id
         placement = link.check_placement(plate_id, free_nest, timeout_s=PLACEMENT_CHECK_TIMEOUT_S)
+        disturbed = moved_bystanders(link, [b for b in before if b.labware_id != plate_id])
     except BridgeError as error:  # no ground truth: the transfer cannot count as delivered
         report.error = report.error or f"physics check failed: no answer from the robot side: {error}"
         return report
@@ -150,6 +160,9 @@ def run_demo(deployment: Deployment, progress_stream: TextIO | None = sys.stderr
         report.plate_yaw_error_deg = math.degrees(placement.yaw_error_rad)
     if not placement.in_nest and not report.error:
         report.error = misplacement(free_nest, placement)
+    if disturbed and not report.error:  # the lab changed beyond the plate moved: not a delivery
+        report.success = False
+        report.error = DISTURBED + "; ".join(disturbed)
     return report
 
 
@@ -177,6 +190,8 @@ def plate_to_judge(link: RobotLink, read_id: str, destination: Nest) -> str:
 
 # Starts every error of a transfer whose commands succeeded but whose plate physics finds misplaced.
 MISPLACED = "physics check: "
+# Starts the error of a transfer that delivered its plate but moved another out of where it rested.
+DISTURBED = f"{MISPLACED}another plate was moved: "
 
 
 def misplacement(destination: Nest, placement: PlacementCheck) -> str:
