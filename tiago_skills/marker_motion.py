@@ -8,9 +8,9 @@ kinematics of the joint readings taken with the image; never from simulator link
 Target "work_pose" moves the base instead (tiago_skills.base_alignment): from the station's POI to
 the working pose in front of the nests, as the marker shows it; with the hand empty, it then reads
 where a plate lies in the nest, and a pick grasps it there (tiago_skills.pick_correction).
-Target "inspect" moves nothing but
-the head: it reads from the depth image whether a plate lies in the nest
-(perception.nest_occupancy), the check of a lab whose nests have no sensors.
+Target "inspect" moves nothing but the head: it reads from the depth image whether a plate lies in
+the nest, the check of a lab whose nests have no sensors. Both looks into a nest are
+tiago_skills.nest_looks.
 
 Steps: take an image (the hardware port) -> detect the marker (this thread) -> T_base_marker =
 T_base_optical @ T_optical_marker -> the nest frame from the world's site_in_marker, sub-position
@@ -27,7 +27,7 @@ from __future__ import annotations
 import logging
 import threading
 from collections.abc import Callable
-from typing import Any, TypeVar
+from typing import Any
 
 import numpy as np
 from labware_interfaces.msg import ErrorCodes
@@ -35,9 +35,9 @@ from labware_interfaces.msg import ErrorCodes
 from lab_description.station_placement import approach_heights
 from lab_description.world import World
 from tiago_description import transforms as tf
-from tiago_description.kinematics import RobotKinematics, head_angles_towards, within_head_limits
+from tiago_description.kinematics import RobotKinematics
 from tiago_description.motion_library import HotelGrasp
-from tiago_skills.base_alignment import HEAD_JOINTS, align_base, search_marker, working_pose
+from tiago_skills.base_alignment import align_base, search_marker, working_pose
 from tiago_skills.behaviours import (
     FLIP_ABOUT_APPROACH,
     TOOL_SPEED_FREE,
@@ -50,19 +50,16 @@ from tiago_skills.gaze import marker_and_held_plate
 from tiago_skills.goal_run import ActionAbort, GoalRun
 from tiago_skills.joint_commands import move_joints
 from tiago_skills.marker_sighting import MarkerSighting, pose_msg, same_place
+from tiago_skills.nest_looks import CAMERA_FRAME, NestLooks
 from tiago_skills.perception.aruco import detect_marker
-from tiago_skills.perception.nest_occupancy import NestView, view_nest
-from tiago_skills.perception.site_frames import nest_in_base
-from tiago_skills.pick_correction import LOOK_AT_NEST, NEST_EMPTY, plate_in_nest
+from tiago_skills.pick_correction import NEST_EMPTY
 from tiago_skills.place_correction import LOOK_AGAIN, place_shift
 from tiago_skills.reachable import first_reachable, put_twin
 
 log = logging.getLogger(__name__)
-T = TypeVar("T")
 
 TARGETS = ("site_approach", "site", "work_pose", "inspect")
 LINE_ONLY_RADIUS_M = 0.03  # a tool this near the column above the site moves only in straight lines
-CAMERA_FRAME = "head_front_camera_rgb_optical_frame"
 
 
 class MarkerMotionBehaviour:
@@ -80,10 +77,7 @@ class MarkerMotionBehaviour:
         self.kinematics = RobotKinematics()
         self._lock = threading.Lock()
         self.last_sighting: MarkerSighting | None = None
-        # (station, nest) -> (odometry, height) of the floor the last look saw empty in that nest
-        self.floors_seen: dict[tuple[str, int], tuple[tuple[float, float, float], float]] = {}
-        # (station, nest) -> (odometry, pose in the nest frame) of the plate the last look found there
-        self.plates_seen: dict[tuple[str, int], tuple[tuple[float, float, float], tf.Planar]] = {}
+        self.nests = NestLooks(world, self.kinematics, self._lock)
 
     def look(self, run: GoalRun, station_name: str) -> MarkerSighting:
         """Image + joints at one instant, marker detection, marker pose in base_footprint."""
@@ -134,85 +128,8 @@ class MarkerMotionBehaviour:
         )
 
     def inspect(self, run: GoalRun, station: Any, sub_position: int) -> dict:
-        """Whether a plate lies in the nest, from the depth image: from the head as it stands if the
-        nest is in view, else aimed at it and turned back after, so that a later place measures its
-        held plate with the head where it saw the marker (place_correction); NEST_NOT_SEEN when the
-        camera cannot see into the nest."""
-        sighting = self._sighting_here(run, station)
-        T_base_site = self._nest_seen(station, sub_position, sighting)
-        key, odometry = (station.name, sub_position), run.read(lambda hardware: tuple(hardware.odometry()))
-        floor = self.floors_seen.get(key)
-        floor_m = floor[1] if floor is not None and same_place(floor[0], odometry) else None
-        view = self._view(run, T_base_site, floor_m)
-        if not view.seen:
-            where = f"nest {sub_position} of {station.name}"
-            log.info("%s not seen from here (%s): aiming the head at it", where, view.reason)
-            view = self._aimed_at(run, T_base_site, lambda: self._view(run, T_base_site, floor_m))
-        log.info("nest %d of %s: %s", sub_position, station.name, view.reason)
-        if view.occupied is False:
-            self.floors_seen[key] = (odometry, view.height_m)
-        if not view.seen:
-            raise ActionAbort(
-                ErrorCodes.NEST_NOT_SEEN,
-                f"the head camera cannot see into nest {sub_position} of {station.name}: {view.reason}",
-            )
-        return {
-            "marker_in_base": pose_msg(sighting.T_base_marker),
-            "nest_occupied": bool(view.occupied),
-            "plate_seated": view.seated,
-        }
-
-    def _view(self, run: GoalRun, T_base_site: np.ndarray, floor_m: float | None) -> NestView:
-        depth, intrinsics, T_site_optical = self._nest_image(run, T_base_site)
-        sizes = [(t.length, t.width, t.height) for t in self.world.labware_types.values()]
-        return view_nest(depth, intrinsics, T_site_optical, sizes, floor_m)
-
-    def _nest_image(self, run: GoalRun, T_base_site: np.ndarray) -> tuple[np.ndarray, Any, np.ndarray]:
-        """A depth image, its intrinsics and the camera's pose in the nest frame when it was taken."""
-        run.feedback(max(run.progress, 0.1), "looking into the nest", 0.0, force=True)
-        frame = run.read(lambda hardware: hardware.capture_head_camera())
-        with self._lock:
-            T_base_optical = self.kinematics.forward(frame.joints, CAMERA_FRAME)
-        return frame.depth, frame.intrinsics, tf.invert(T_base_site) @ T_base_optical
-
-    def _aimed_at(self, run: GoalRun, T_base_site: np.ndarray, look: Callable[[], T]) -> T:
-        """``look()`` with the head aimed at the nest, then turned back: a later place measures its held
-        plate with the head where it saw the marker (place_correction)."""
-        joints = run.read(lambda hardware: dict(hardware.joint_positions()))
-        back = {name: joints[name] for name in HEAD_JOINTS}
-        aim = within_head_limits(head_angles_towards(self.kinematics, joints, T_base_site[:3, 3]))
-        low = max(run.progress, 0.2)
-        run.follow(move_joints(aim), span=(low, low + (1.0 - low) / 3))
-        seen = look()
-        run.follow(move_joints(back), span=(low + 2 * (1.0 - low) / 3, 1.0))
-        return seen
-
-    def _find_plate(self, run: GoalRun, station: Any, sub_position: int, sighting: MarkerSighting) -> str:
-        """Where the plate lies in the nest before a pick (pick_correction), kept for the nest's motions
-        while the base stands here. A put's nest reads empty and keeps nothing."""
-        key = (station.name, sub_position)
-        self.plates_seen.pop(key, None)
-        T_base_site = self._nest_seen(station, sub_position, sighting)
-
-        def plate_seen() -> tuple[tf.Planar | None, str]:
-            return plate_in_nest(*self._nest_image(run, T_base_site), self.world.labware_types.values())
-
-        pose, why = plate_seen()
-        if pose is None and why in LOOK_AT_NEST:
-            log.info("nest %d of %s: %s; aiming the head at it", sub_position, station.name, why)
-            pose, why = self._aimed_at(run, T_base_site, plate_seen)
-        log.info("nest %d of %s: %s", sub_position, station.name, f"plate at {why}" if pose else why)
-        if pose is not None:
-            self.plates_seen[key] = (sighting.odometry, pose)
-        return why
-
-    def _nest_seen(
-        self, station: Any, sub_position: int, sighting: MarkerSighting, above_m: float = 0.0
-    ) -> np.ndarray:
-        """The nest (or the point ``above_m`` over it) in base_footprint, from a marker sighting."""
-        T_marker_site = station.T_marker_site(sub_position) @ tf.make_transform((0.0, 0.0, above_m))
-        height = float((station.T_world_marker() @ T_marker_site)[2, 3])
-        return nest_in_base(sighting.T_base_marker, station.T_table_marker(), T_marker_site, height)
+        """Whether a plate lies in the nest, from the depth image (`NestLooks.inspect`)."""
+        return self.nests.inspect(run, station, sub_position, self._sighting_here(run, station))
 
     def _centred_on_plate(
         self,
@@ -315,8 +232,8 @@ class MarkerMotionBehaviour:
             )
             if not self.behaviours.holding.get(arm, False):
                 self.behaviours.twin_wanted[arm] = None  # a pick takes the twin of least travel
-                if self._find_plate(run, station, sub_position, sighting) == NEST_EMPTY:  # a put
-                    site = self._nest_seen(station, sub_position, sighting)
+                if self.nests.find_plate(run, station, sub_position, sighting) == NEST_EMPTY:  # a put
+                    site = self.nests.nest_seen(station, sub_position, sighting)
                     seed = run.read(lambda hardware: dict(hardware.joint_positions()))
                     heights = self._approach_heights(station)
                     wanted = put_twin(self.behaviours, arm, site, heights, self.grasp, seed)
@@ -337,14 +254,16 @@ class MarkerMotionBehaviour:
         # The marker's tilt comes from the level bench, not the image (perception.site_frames.upright_marker).
         # The height is the bench's (world file), not the sighting's (perception.site_frames.at_height).
 
-        plate = self.plates_seen.get((station.name, sub_position))  # a pick: the grasp goes to the plate
+        plate = self.nests.plates_seen.get(
+            (station.name, sub_position)
+        )  # a pick: the grasp goes to the plate
         on_plate = (
             tf.from_planar(*plate[1]) if plate and same_place(plate[0], sighting.odometry) else np.eye(4)
         )
 
         def site_seen(seen: MarkerSighting, above_m: float = 0.0) -> np.ndarray:
             """The nest (or the point `above_m` over it) in base_footprint, from a marker sighting."""
-            return self._nest_seen(station, sub_position, seen, above_m) @ on_plate
+            return self.nests.nest_seen(station, sub_position, seen, above_m) @ on_plate
 
         releasing = goal.target == "site" and self.behaviours.holding.get(arm, False)
         grasp_in_site = self.grasp.T_slot_grasp(approach=False, releasing=releasing)

@@ -92,7 +92,7 @@ class RobotSkills:
         self.behaviours.twin_wanted.clear()
         self.behaviours.holding.clear()
         self.marker_motion.last_sighting = None
-        self.marker_motion.floors_seen.clear()
+        self.marker_motion.nests.floors_seen.clear()
         self.actions.activity.clear()
 
     def _on_parameters(self, parameters: list[Parameter]) -> SetParametersResult:
