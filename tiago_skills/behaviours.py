@@ -26,6 +26,7 @@ from tiago_skills.arm_planning import ArmPlanning
 from tiago_skills.drive_estimate import planned_drive_s
 from tiago_skills.drive_posture import torso_for_drive
 from tiago_skills.goal_run import ActionAbort, GoalRun
+from tiago_skills.grasp_check import grasp_width_problem
 from tiago_skills.joint_commands import move_joints
 from tiago_skills.tool_path import tool_trajectory
 
@@ -48,26 +49,8 @@ OPEN_FINGER_REACH = rm.FINGER_MOUNT_OFFSET + rm.FINGER_TRAVEL + rm.PAD_THICKNESS
 BENCH_EDGE_MARGIN = 0.02
 BENCH_FRONT_X = WORKING_CLEARANCE - OPEN_FINGER_REACH - BENCH_EDGE_MARGIN
 
-# Fingers closed on a plate stand its short side apart; on a plate tilted over 28 deg about its long
-# side (seen: 75 mm apart on an 85.5 mm plate, which then fell over in the hotel) off by more than this.
-GRASP_WIDTH_TOLERANCE_M = 0.004
-
 # Half-turn about the grasp x axis: the same top-down grasp with the fingers swapped.
 FLIP_ABOUT_APPROACH = make_transform(rotation=np.diag([1.0, -1.0, -1.0]))
-
-
-def grasp_width_problem(opening_m: float, plate_widths: tuple[float, ...]) -> str:
-    """Why fingers closed `opening_m` apart do not hold one of the lab's plates flat ("" if they
-    do, or when no widths are known): a plate held flat spans its short side."""
-    if not plate_widths:
-        return ""
-    nearest = min(plate_widths, key=lambda width: abs(width - opening_m))
-    if abs(nearest - opening_m) <= GRASP_WIDTH_TOLERANCE_M:
-        return ""
-    return (
-        f"the fingers closed {1000 * opening_m:.1f} mm apart, and no plate of this lab is that wide "
-        f"(nearest {1000 * nearest:.1f} mm): the plate is not held flat"
-    )
 
 
 class RobotBehaviours:

@@ -11,7 +11,7 @@ import math
 
 import pytest
 
-from tiago_skills.behaviours import GRASP_WIDTH_TOLERANCE_M, grasp_width_problem
+from tiago_skills.grasp_check import GRASP_WIDTH_TOLERANCE_M, grasp_width_problem
 
 SBS = 0.08548
 HEIGHT = 0.01435
