@@ -6,7 +6,10 @@ centre and the tool, with the marker at a row's far end 0.59 m right of the base
 0.54 m to its left, 0.95 m high, the plate's outer end lay past the image's corner: the plate, near
 the camera, spans far more of the image than the marker. Nothing was measured, and the place went
 down uncorrected beside the nest. The head is now turned until the outlines' extent is centred in
-the image, and the caller learns whether everything fits.
+the image, and the caller learns whether everything fits. Where marker and plate cannot fit in one
+image (a marker 0.5 m or more beside the nest, seen from near), the plate is framed alone and measured
+against the nest the first image's marker gave: the camera's error then changes with the head's turn
+between the two images (about a millimetre at the nest per 0.1 rad, against 8 to 11 mm unmeasured).
 
 Pure computation on the robot model; safe on any thread that owns its own `RobotKinematics`.
 """
@@ -96,12 +99,27 @@ def marker_and_held_plate(
     world: World,
     T_base_site: np.ndarray,
     tool_in_base: np.ndarray,
+    *,
+    with_marker: bool = True,
 ) -> tuple[dict[str, float], bool]:
     """The head's aim (within its limits) that frames the sighting's marker and the plate held by the
-    tool over the site together, and whether both then fit in the image."""
-    marker = marker_outline(sighting.T_base_marker, world.station(sighting.station).marker_size)
+    tool over the site together, and whether both then fit in the image. Without the marker
+    (`with_marker` False): the plate alone, the look of last resort where the two do not fit."""
+    points = _plate_outline(world, T_base_site, tool_in_base)
+    if with_marker:
+        marker = marker_outline(sighting.T_base_marker, world.station(sighting.station).marker_size)
+        points = np.vstack([marker, points])
+    return _framed(kinematics, joints, points, sighting.intrinsics)
+
+
+def _plate_outline(world: World, T_base_site: np.ndarray, tool_in_base: np.ndarray) -> np.ndarray:
     sizes = [(labware.length, labware.width) for labware in world.labware_types.values()]
-    points = np.vstack([marker, held_plate_outline(T_base_site, tool_in_base, sizes)])
-    aim, fits = head_angles_framing(kinematics, joints, points, sighting.intrinsics)
+    return held_plate_outline(T_base_site, tool_in_base, sizes)
+
+
+def _framed(
+    kinematics: RobotKinematics, joints: dict[str, float], points: np.ndarray, intrinsics: CameraIntrinsics
+) -> tuple[dict[str, float], bool]:
+    aim, fits = head_angles_framing(kinematics, joints, points, intrinsics)
     limited = within_head_limits(aim)
     return limited, fits and all(abs(limited[name] - aim[name]) < 1e-9 for name in aim)

@@ -24,6 +24,7 @@ marker from the head). Lives on: an rclpy executor thread (one goal at a time).
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import threading
 from collections.abc import Callable
@@ -143,7 +144,9 @@ class MarkerMotionBehaviour:
         where the tool stands now, above the nest after the approach. When the head has moved since
         the marker's sighting or the plate is not seen whole (an end out of the image: random layouts
         191031, 211038), the head is turned to frame the marker and the plate's outline together
-        (`gaze`), and both are seen again with that one gaze."""
+        (`gaze`), and both are seen again with that one gaze. Where they do not fit in one image, or
+        the marker is lost from it, the plate is framed alone and measured against the nest of the
+        sighting so far (random layout 218178: a marker 0.5 m beside the nest)."""
         T_base_site = site_seen(sighting)
         shift, why = self._shift(run, arm, T_base_site, sighting)
         if shift is None and why in LOOK_AGAIN:
@@ -152,19 +155,41 @@ class MarkerMotionBehaviour:
             aim, fits = marker_and_held_plate(
                 self.kinematics, joints, sighting, self.world, T_base_site, tool
             )
-            log.info("looking again with marker and held plate in one view (%s)%s", why, "" if fits else
-                     ": they do not fit in it whole")  # fmt: skip
+            if not fits:
+                log.info("marker and held plate do not fit in one view (%s): framing the plate alone", why)
+                return self._plate_alone(run, arm, T_base_site, sighting, tool), sighting
+            log.info("looking again with marker and held plate in one view (%s)", why)
             run.follow(move_joints(aim), span=(0.0, 0.1))
             try:
-                sighting = self.look(run, sighting.station)
-            except ActionAbort as lost:  # the place goes on as the first sighting shows it
+                seen = self.look(run, sighting.station)
+            except ActionAbort as lost:
                 if lost.code != ErrorCodes.MARKER_NOT_FOUND:
                     raise
-                log.info("held plate not measured: %s from the new gaze", lost.message)
-                return T_base_site, sighting
-            T_base_site = site_seen(sighting)
+                log.info("%s from the new gaze: framing the held plate alone", lost.message)
+                return self._plate_alone(run, arm, T_base_site, sighting, tool), sighting
+            sighting, T_base_site = seen, site_seen(seen)
             shift, why = self._shift(run, arm, T_base_site, sighting)
         return (T_base_site if shift is None else T_base_site @ tf.from_planar(*shift)), sighting
+
+    def _plate_alone(
+        self, run: GoalRun, arm: str, T_base_site: np.ndarray, sighting: MarkerSighting, tool: np.ndarray
+    ) -> np.ndarray:
+        """The site moved by the shift the held plate measured in a view of its own calls for (as it is
+        when the plate is not measured): the nest from `sighting`, the plate from the new image; the
+        camera's error between the two head aims is not cancelled (`gaze`)."""
+        joints = run.read(lambda hardware: dict(hardware.joint_positions()))
+        aim, fits = marker_and_held_plate(
+            self.kinematics, joints, sighting, self.world, T_base_site, tool, with_marker=False
+        )
+        run.follow(move_joints(aim), span=(0.0, 0.1))
+        now = run.read(lambda hardware: dict(hardware.joint_positions()))
+        shift, why = self._shift(run, arm, T_base_site, dataclasses.replace(sighting, joints=now))
+        if shift is None:
+            log.info("held plate not measured alone either (%s): placing where the marker says", why)
+            return T_base_site
+        whole = "" if fits else " (its outline beyond the image)"
+        log.info("held plate measured in a view of its own%s", whole)
+        return T_base_site @ tf.from_planar(*shift)
 
     def _shift(
         self, run: GoalRun, arm: str, T_base_site: np.ndarray, sighting: MarkerSighting

@@ -45,3 +45,21 @@ def test_a_plate_half_out_of_the_image_is_seen_again_and_placed(
     assert MEASURED in after, "the second gaze did not measure the plate"
     outcome = json.loads(done.stdout)["outcomes"][0]
     assert outcome["success"], outcome
+
+
+def test_a_plate_that_does_not_fit_in_one_image_with_the_marker_is_measured_alone_and_placed(
+    tmp_path: Path,
+) -> None:
+    """Random layout 218178 (campaign seed 218000 at d157de8): above labeler/4 the held plate and the
+    marker 0.5 m beside it could not be framed together; the joint gaze lost the marker, and the
+    plate went down unmeasured off the nest (PLACE_FAILED). The plate is now framed and measured
+    alone, against the nest the first sighting gave."""
+    logs = tmp_path / "logs"
+    world = str(FIXTURES / "marker_and_plate_apart.yaml")
+    done = run_bench("--world", world, "--replay", "218178", "--json", "--log-dir", str(logs), "--verbose")
+    skills_log = (logs / "sim_node.log").read_text()
+    _, _, after = skills_log.partition("marker and held plate do not fit in one view")
+    assert after, "marker and plate fitted in one view: the fixture lost its point"
+    assert "held plate measured in a view of its own" in after and MEASURED in after
+    outcome = json.loads(done.stdout)["outcomes"][0]
+    assert outcome["success"], outcome
