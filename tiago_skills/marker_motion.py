@@ -229,6 +229,29 @@ class MarkerMotionBehaviour:
         tool = self.behaviours.planning.tool_pose(arm, joints)[:3, 3]
         return float(np.hypot(*(tool[:2] - T_base_target[:2, 3]))) <= LINE_ONLY_RADIUS_M
 
+    def _straight_in_the_column(
+        self, run: GoalRun, arm: str, grasps: list[np.ndarray], speed: float, span: tuple[float, float]
+    ) -> None:
+        """Straight up or down the column above the nest to the first of `grasps` (the approach heights
+        that reach, highest first) whose line the arm can follow, the tool turned as it stands (the twin
+        it is in). Why: after a release the empty gripper's twin is free, and the one of least joint
+        travel at the approach was the other: the line up turned the wrist half round and passed a flip
+        the arm could not follow, with the torso either, 80 mm over a nest 0.88 m high (random layout
+        219071); a lower approach is tried before giving up."""
+        joints = run.read(lambda hardware: dict(hardware.joint_positions()))
+        now = self.behaviours.planning.tool_pose(arm, joints)[:3, :3]
+        for number, T_base_grasp in enumerate(grasps):
+            flipped = T_base_grasp @ FLIP_ABOUT_APPROACH
+            turned = np.linalg.norm(flipped[:3, :3] - now) < np.linalg.norm(T_base_grasp[:3, :3] - now)
+            try:
+                self.behaviours.straight_move(run, arm, flipped if turned else T_base_grasp, speed, span)
+                self.behaviours.grasp_flipped[arm] = bool(turned)
+                return
+            except ActionAbort as abort:
+                if abort.code != ErrorCodes.IK_FAILED or number == len(grasps) - 1:
+                    raise
+                log.info("no straight line up the column (%s): trying a lower approach", abort.message)
+
     def __call__(self, run: GoalRun, goal: Any) -> dict:
         arm = self.behaviours.arm_of(goal.arm)
         try:
@@ -323,7 +346,7 @@ class MarkerMotionBehaviour:
                 return {"marker_in_base": marker_in_base}
             first = self.behaviours.rise_before_bench(run, arm, T_base_target, first)
             if self._in_the_column(run, arm, T_base_target):
-                self.behaviours.straight_move(run, arm, T_base_target, speed, (first, 1.0))
+                self._straight_in_the_column(run, arm, grasps[index:], speed, (first, 1.0))
                 return {"marker_in_base": marker_in_base}
             holding = self.behaviours.holding.get(arm, False)
             # An empty gripper may come down as either twin: the other one may have a clear way.
