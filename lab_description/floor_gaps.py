@@ -45,6 +45,14 @@ def dock_distances(dock_pose, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:  # 
     return rectangle_distances((dock.x, dock.y, dock.yaw), dock.length, dock.width, xs, ys)
 
 
+def obstacle_distances(obstacle, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:  # noqa: ANN001 - Obstacle
+    """Distance (m) from each floor point to a free-standing obstacle's outline (box or cylinder)."""
+    if obstacle.is_cylinder:
+        return np.hypot(xs - obstacle.x, ys - obstacle.y) - obstacle.radius
+    centre = (obstacle.x, obstacle.y, obstacle.yaw)
+    return rectangle_distances(centre, obstacle.length, obstacle.width, xs, ys)
+
+
 def drive_points(start, end, count: int) -> tuple[np.ndarray, np.ndarray]:  # noqa: ANN001 - Pose2D
     """`count` + 1 floor points evenly along the straight drive from `start` to `end`, both ends in."""
     k = np.arange(count + 1, dtype=float) / count

@@ -36,7 +36,7 @@ from labware_interfaces.msg import ErrorCodes
 from lab_description.station_placement import approach_heights
 from lab_description.world import World
 from tiago_description import transforms as tf
-from tiago_description.kinematics import RobotKinematics
+from tiago_description.kinematics import CAMERA_FRAME, RobotKinematics
 from tiago_description.motion_library import HotelGrasp
 from tiago_skills.base_alignment import align_base, search_marker, working_pose
 from tiago_skills.behaviours import (
@@ -51,7 +51,7 @@ from tiago_skills.gaze import marker_and_held_plate
 from tiago_skills.goal_run import ActionAbort, GoalRun
 from tiago_skills.joint_commands import move_joints
 from tiago_skills.marker_sighting import MarkerSighting, pose_msg, same_place
-from tiago_skills.nest_looks import CAMERA_FRAME, NestLooks
+from tiago_skills.nest_looks import NestLooks
 from tiago_skills.perception.aruco import detect_marker
 from tiago_skills.pick_correction import NEST_EMPTY
 from tiago_skills.place_correction import LOOK_AGAIN, place_shift

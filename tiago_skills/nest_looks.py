@@ -20,7 +20,12 @@ from labware_interfaces.msg import ErrorCodes
 
 from lab_description.world import World
 from tiago_description import transforms as tf
-from tiago_description.kinematics import RobotKinematics, head_angles_towards, within_head_limits
+from tiago_description.kinematics import (
+    CAMERA_FRAME,
+    RobotKinematics,
+    head_angles_towards,
+    within_head_limits,
+)
 from tiago_skills.base_alignment import HEAD_JOINTS
 from tiago_skills.goal_run import ActionAbort, GoalRun
 from tiago_skills.joint_commands import move_joints
@@ -32,7 +37,6 @@ from tiago_skills.pick_correction import LOOK_AT_NEST, plate_in_nest
 log = logging.getLogger(__name__)
 T = TypeVar("T")
 
-CAMERA_FRAME = "head_front_camera_rgb_optical_frame"
 Odometry = tuple[float, float, float]
 
 

@@ -29,10 +29,9 @@ from functools import lru_cache
 
 import numpy as np
 
-from lab_description.floor_gaps import bench_distances, dock_distances, rectangle_distances
+from lab_description.floor_gaps import bench_distances, dock_distances, obstacle_distances
 from lab_description.serviceability import ALIGN_DRIVE_OVERSHOOT, ALIGN_SIGHTING_ERROR
 from lab_description.world import World, load_world
-from lab_description.world_obstacles import Obstacle
 from tiago_description import robot_model as rm
 from tiago_description import transforms as tf
 from tiago_description.hotel_model import HOTEL_POCKET_SIZE, HOTEL_SLOT_XYZ, TRAY_BEYOND_POCKET
@@ -119,13 +118,6 @@ def tray_outline(step: float = 0.02) -> np.ndarray:
     return np.vstack(edges)
 
 
-def _obstacle_distances(obstacle: Obstacle, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
-    if obstacle.is_cylinder:
-        return np.hypot(xs - obstacle.x, ys - obstacle.y) - obstacle.radius
-    centre = (obstacle.x, obstacle.y, obstacle.yaw)
-    return rectangle_distances(centre, obstacle.length, obstacle.width, xs, ys)
-
-
 def free_poses(world: World, xs: np.ndarray, ys: np.ndarray, yaw: float) -> np.ndarray:
     """Which base poses (xs, ys, heading `yaw`) keep the footprint `STOP_ERROR_M` clear of everything."""
     half = world.floor_size / 2
@@ -135,7 +127,7 @@ def free_poses(world: World, xs: np.ndarray, ys: np.ndarray, yaw: float) -> np.n
     for station in world.stations:
         free &= bench_distances(station, xs, ys) >= reach
     for obstacle in world.obstacles:
-        free &= _obstacle_distances(obstacle, xs, ys) >= reach
+        free &= obstacle_distances(obstacle, xs, ys) >= reach
     c, s = math.cos(yaw), math.sin(yaw)
     for ahead, left in tray_outline():
         px, py = xs + c * ahead - s * left, ys + s * ahead + c * left
@@ -144,7 +136,7 @@ def free_poses(world: World, xs: np.ndarray, ys: np.ndarray, yaw: float) -> np.n
             free &= bench_distances(station, px, py) >= STOP_ERROR_M
         for obstacle in world.obstacles:
             if obstacle.height > TRAY_LOW_M:
-                free &= _obstacle_distances(obstacle, px, py) >= STOP_ERROR_M
+                free &= obstacle_distances(obstacle, px, py) >= STOP_ERROR_M
     return free
 
 
