@@ -13,7 +13,7 @@ import math
 from tiago_description.urdf_writer import UrdfWriter
 
 # Hotel (onboard plate holder): pocket floors on the base front, reachable top-down by either arm
-HOTEL_SLOT_XYZ = ((0.25, -0.07, 0.60), (0.25, 0.07, 0.60))
+HOTEL_SLOT_XYZ = ((0.25, 0.07, 0.60), (0.25, -0.07, 0.60))
 HOTEL_POCKET_SIZE = (0.1318, 0.0895)  # inner length x width, 2 mm clearance per side
 TRAY_BEYOND_POCKET = (0.03, 0.02)  # m: the tray plate is the pocket plus this along x and across
 # Per side, 45 deg ramps rising from the pocket floor at the pocket edge to this far outside it (the

@@ -21,13 +21,13 @@ from lab_description.serviceability import WORKING_CLEARANCE
 from robot_port.types import ARM_SIDES, JointTrajectory
 from tiago_description import robot_model as rm
 from tiago_description.motion_library import HOTEL_MOTIONS, MotionLibrary
-from tiago_description.transforms import make_transform
 from tiago_skills.arm_planning import ArmPlanning
 from tiago_skills.drive_estimate import planned_drive_s
 from tiago_skills.drive_posture import torso_for_drive
 from tiago_skills.goal_run import ActionAbort, GoalRun
 from tiago_skills.grasp_check import grasp_width_problem
-from tiago_skills.joint_commands import move_joints
+from tiago_skills.grasp_twins import FLIP_ABOUT_APPROACH, twin_times, twin_with_a_way_down
+from tiago_skills.joint_commands import keyframe_points, move_joints
 from tiago_skills.tool_path import tool_trajectory
 
 log = logging.getLogger(__name__)
@@ -48,9 +48,6 @@ CREEP_HEIGHT = 0.018  # m above a pocket where the slow creep starts (rims: nest
 OPEN_FINGER_REACH = rm.FINGER_MOUNT_OFFSET + rm.FINGER_TRAVEL + rm.PAD_THICKNESS
 BENCH_EDGE_MARGIN = 0.02
 BENCH_FRONT_X = WORKING_CLEARANCE - OPEN_FINGER_REACH - BENCH_EDGE_MARGIN
-
-# Half-turn about the grasp x axis: the same top-down grasp with the fingers swapped.
-FLIP_ABOUT_APPROACH = make_transform(rotation=np.diag([1.0, -1.0, -1.0]))
 
 
 class RobotBehaviours:
@@ -171,33 +168,33 @@ class RobotBehaviours:
         # stays above 0.85 m (tests/tiago_description/test_fold_sweep.py).
         first = self.leave_hotel(run, arm) or self.leave_bench(run, arm)
         speed = self.speed_scale() * self.motions.speed_scale
-        for index, targets in enumerate(frames):
-            span = (
-                first + (1 - first) * index / len(frames),
-                first + (1 - first) * (index + 1) / len(frames),
-            )
-            run.follow(move_joints(targets, speed), span=span)
+        # All keyframes as one trajectory, as PAL's play_motion2 sends them: the joints pass each
+        # keyframe without stopping (a stop at each cost a ramp down and up, about 0.3 s a keyframe).
+        joints = run.read(lambda hardware: dict(hardware.joint_positions()))
+        trajectory = JointTrajectory(keyframe_points(joints, frames), speed)
+        run.follow(lambda hardware: hardware.follow_joint_trajectory(trajectory), span=(first, 1.0))
         return {}
 
-    def grasp_twin(self, arm: str, T_base_grasp: np.ndarray, seed: dict[str, float]) -> np.ndarray:
+    def grasp_twin(
+        self, arm: str, T_base_grasp: np.ndarray, seed: dict[str, float], *, only: bool | None = None
+    ) -> np.ndarray:
         """A top-down grasp pose or its twin with the fingers swapped (half-turn about the approach).
 
         With a plate in the gripper, the twin used when it was grasped, so the plate keeps its
-        orientation from nest to hotel and back; otherwise the one a put's nest needs (`twin_wanted`:
-        the twin that fetches a plate from the hotel is the one that puts it down) if it reaches, else
-        the one the arm reaches with less joint travel (e.g. 1.5 instead of 2.7 rad from the tucked
-        arm to the hotel).
+        orientation from nest to hotel and back; otherwise `only` if given, else the one a put's nest
+        needs (`twin_wanted`: the twin that fetches a plate from the hotel is the one that puts it
+        down) if it reaches, else the one the arm reaches sooner (`move_s`: 0.2 m of torso takes
+        2.9 s, 2.8 rad of an arm joint about 1.5 s).
         """
         twins = {False: T_base_grasp, True: T_base_grasp @ FLIP_ABOUT_APPROACH}
-        order = [self.grasp_flipped.get(arm, False)] if self.holding.get(arm) else [False, True]
-        travel = {}  # twin -> largest joint change to reach it (the slowest joint sets the pace)
-        for flip in order:
-            joints = self.planning.solve_ik(arm, twins[flip], seed)
-            if joints is not None:
-                travel[flip] = max(abs(value - seed.get(name, value)) for name, value in joints.items())
-        if travel:
+        if self.holding.get(arm):
+            order = [self.grasp_flipped.get(arm, False)]
+        else:
+            order = [False, True] if only is None else [only]
+        duration = twin_times(self.planning, arm, T_base_grasp, seed, order)
+        if duration:
             wanted = None if self.holding.get(arm) else self.twin_wanted.get(arm)
-            flip = wanted if wanted in travel else min(travel, key=travel.get)
+            flip = wanted if wanted in duration else min(duration, key=duration.get)
             self.grasp_flipped[arm] = flip
             return twins[flip]
         raise ActionAbort(
@@ -217,12 +214,13 @@ class RobotBehaviours:
         *,
         free: bool = False,
         tool_speed: float = TOOL_SPEED_FREE,
+        only: bool | None = None,
     ) -> None:
         """Straight tool move to a top-down grasp pose; with `free`, a joint-space move when the
         gripper is empty or no straight line exists (e.g. from the folded arm, where nothing is in
         the way)."""
         seed = run.read(lambda hardware: dict(hardware.joint_positions()))
-        target = self.grasp_twin(arm, T_base_grasp, seed)
+        target = self.grasp_twin(arm, T_base_grasp, seed, only=only)
         if free and not self.holding.get(arm):  # an empty gripper from the tucked arm: the short way
             self.joint_space_move(run, arm, target, span)
             return
@@ -360,8 +358,14 @@ class RobotBehaviours:
         first = self.leave_bench(run, arm)
         T_carry = T_approach.copy()
         T_carry[2, 3] += self.motions.hotel.carry_height_m
-        self._tool_move(run, arm, T_carry, (first, 0.7), free=True)
-        self._tool_move(run, arm, T_approach, (0.7, 1.0))
+        twin = None
+        if not self.holding.get(arm):
+            seed = run.read(lambda hardware: dict(hardware.joint_positions()))
+            twin = twin_with_a_way_down(
+                self.planning, arm, seed, (T_carry, T_approach), self.twin_wanted.get(arm)
+            )
+        self._tool_move(run, arm, T_carry, (first, 0.7), free=True, only=twin)
+        self._tool_move(run, arm, T_approach, (0.7, 1.0), only=twin)
 
     # -- gripper ------------------------------------------------------------------------
     def gripper(self, run: GoalRun, goal: Any) -> dict:

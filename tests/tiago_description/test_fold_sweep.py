@@ -74,9 +74,10 @@ def test_folding_from_the_hotel_approach_sweeps_the_pads_over_a_bench_edge(
     kinematics: RobotKinematics,
 ) -> None:
     """The cause of 91089: the pads pass ahead of the nearest bench edge below the highest bench top
-    (at some torso height the straight moves before may leave)."""
+    (at some torso height the straight moves before may leave). 91089's plate was in the pocket on
+    the right arm's side, slot 2 since the left one is slot 1."""
     tuck = load_motions().frames_for("Tuck", ARM)[0]
-    starts = [hotel_start(kinematics, 1, False, 0.0, torso) for torso in (0.15, 0.2, 0.25)]
+    starts = [hotel_start(kinematics, 2, False, 0.0, torso) for torso in (0.15, 0.2, 0.25)]
     lowest = min(lowest_pad_ahead(kinematics, start, tuck) for start in starts if start is not None)
     assert lowest < HIGHEST_BENCH_TOP_M
 

@@ -6,7 +6,10 @@ the plate went down uncorrected onto the nest's brackets (PLACE_FAILED). The ski
 head between the marker and the tool and saw both again with that one gaze. Random layout 211038
 (campaign seed 211000 at d184587): above storage/1, 0.59 m right of the base and 0.9 m high, that
 gaze still left the plate's outer end past the image's corner, and the place failed the same way.
-The head now frames the marker's and the plate's outlines together (`tiago_skills.gaze`).
+The head now frames the marker's and the plate's outlines together (`tiago_skills.gaze`). Since
+the fetch from the hotel takes the twin sooner in the pocket (hotel slot 1 the left pocket), 191031
+holds its plate the other way round and sees it whole at the first gaze; 211038 still does not, and
+is the fixture.
 
 (What the skills do when a measured place lies beyond the arm's reach: test_reachable.py.)
 
@@ -19,8 +22,6 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import pytest
-
 from tests.sila_labware.benchmarks.test_bench import run_bench
 
 FIXTURES = Path(__file__).parent / "fixtures"
@@ -28,16 +29,10 @@ LOOKED_AGAIN = "looking again with marker and held plate in one view"
 MEASURED = "held plate at ("
 
 
-@pytest.mark.parametrize(
-    ("fixture", "seed"),
-    [("plate_beyond_the_image_edge.yaml", "191031"), ("plate_beyond_the_image_corner.yaml", "211038")],
-)
-def test_a_plate_half_out_of_the_image_is_seen_again_and_placed(
-    tmp_path: Path, fixture: str, seed: str
-) -> None:
+def test_a_plate_half_out_of_the_image_is_seen_again_and_placed(tmp_path: Path) -> None:
     logs = tmp_path / "logs"
-    world = str(FIXTURES / fixture)
-    done = run_bench("--world", world, "--replay", seed, "--json", "--log-dir", str(logs), "--verbose")
+    world = str(FIXTURES / "plate_beyond_the_image_corner.yaml")
+    done = run_bench("--world", world, "--replay", "211038", "--json", "--log-dir", str(logs), "--verbose")
     skills_log = (logs / "sim_node.log").read_text()
     first, _, after = skills_log.partition(LOOKED_AGAIN)
     assert after, "the plate was seen whole at the first gaze: the fixture lost its point"

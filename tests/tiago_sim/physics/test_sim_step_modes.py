@@ -68,7 +68,9 @@ def test_plate_in_the_hotel_rides_a_drive_clamped_at_long_steps_without_slipping
             sim.step()
         after = _plate_in_base(sim)
         assert np.linalg.norm(after[:3, 3] - before[:3, 3]) < 0.001
-        assert abs(tf.wrap_angle(tf.yaw_of(tf.invert(before) @ after))) < np.radians(0.2)
+        # The clamp holds it, not to the milliradian: 0.12 to 0.26 deg over both pockets and two
+        # seeds; a slip would turn it by degrees (the pocket leaves it 2 mm a side).
+        assert abs(tf.wrap_angle(tf.yaw_of(tf.invert(before) @ after))) < np.radians(0.5)
         assert sim.hotel_readings()[0].labware_id == PLATE
     finally:
         sim.close()
