@@ -99,8 +99,9 @@ def align_base(
 ) -> Any:
     """Look at the marker, drive to the working pose it implies, look again; returns the last sighting.
 
-    `look(run)` takes an image and returns the marker sighting (T_base_marker); `working_joints`
-    are torso/head targets that move while the base drives (e.g. the bench working posture);
+    `look(run)` takes an image and returns the marker sighting (T_base_marker); the torso's target
+    in `working_joints` (the bench working posture) is reached while the base drives, and the head
+    turns to where the marker will be;
     `T_world_work` is the nominal working pose (`working_pose`).
     """
     # Where the base believes it stands (localisation), not the POI: a task may start where the
@@ -124,18 +125,20 @@ def align_base(
             "aligning at %s: working pose at x %.3f y %.3f m, yaw %.1f deg from here",
             station.name, correction[0], correction[1], math.degrees(correction[2]),
         )  # fmt: skip
-        head_at_work = {name: value for name, value in working_joints.items() if name in HEAD_JOINTS}
-        turning = run.read(move_joints(head_at_work)) if head_at_work else None
+        # From the working pose the marker is where the first sighting puts it: the head turns there
+        # while the base drives (the torso's target height in the aim), so the look after the drive
+        # needs no head move of its own (it took 0.3 to 0.6 s after the drive). The bench posture's
+        # fixed head angles see a marker beside the nests of the default lab only: a marker 0.37 m
+        # right of the base was out of the image, MARKER_NOT_FOUND with nothing disturbed.
+        T_marker_at_work = tf.invert(tf.from_planar(*correction)) @ sighting.T_base_marker
+        at_work = {**run.read(lambda hardware: dict(hardware.joint_positions())), **torso}
+        head_at_marker = within_head_limits(head_angles_towards(kinematics, at_work, T_marker_at_work[:3, 3]))
+        turning = run.read(move_joints(head_at_marker))
         background.append(turning)
         run.follow(lambda hardware: hardware.drive_to(goal_in_odom, ALIGN_SPEED), span=(0.2, 0.9))
         for execution, span in ((lifting, (0.9, 0.95)), (turning, (0.95, 1.0))):
             if execution is not None:
                 run.follow(execution, span=span)
-        # From the working pose the marker is where the first sighting puts it; the head aims there
-        # and searches as before. The bench posture's fixed head angles see a marker beside the
-        # nests of the default lab only: a marker 0.37 m right of the base was out of the image,
-        # MARKER_NOT_FOUND with nothing disturbed.
-        T_marker_at_work = tf.invert(tf.from_planar(*correction)) @ sighting.T_base_marker
         # from the working pose: later tool moves reuse this sighting while the base stands
         return search_marker(run, kinematics, T_marker_at_work[:3, 3], look, None)
     except BaseException:

@@ -12,6 +12,7 @@ from __future__ import annotations
 import logging
 import math
 from collections.abc import Callable
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -21,9 +22,10 @@ from lab_description.serviceability import WORKING_CLEARANCE
 from robot_port.types import ARM_SIDES, JointTrajectory
 from tiago_description import robot_model as rm
 from tiago_description.motion_library import HOTEL_MOTIONS, MotionLibrary
+from tiago_description.transforms import from_planar
 from tiago_skills.arm_planning import ArmPlanning
 from tiago_skills.drive_estimate import planned_drive_s
-from tiago_skills.drive_posture import torso_for_drive
+from tiago_skills.drive_posture import posture_for_drive
 from tiago_skills.goal_run import ActionAbort, GoalRun
 from tiago_skills.grasp_check import grasp_width_problem
 from tiago_skills.grasp_twins import FLIP_ABOUT_APPROACH, twin_times, twin_with_a_way_down
@@ -65,6 +67,7 @@ class RobotBehaviours:
         seed: int | None = None,
         plate_widths: tuple[float, ...] = (),
         station_pois: frozenset[str] = frozenset(),
+        marker_at_poi: Callable[[str], np.ndarray | None] = lambda _poi: None,
     ) -> None:
         self.poi_pose = poi_pose
         self.poi_names = poi_names
@@ -74,6 +77,7 @@ class RobotBehaviours:
         self.speed_scale = speed_scale
         self.plate_widths = plate_widths  # the short sides of the lab's plate types: what a grasp spans
         self.station_pois = station_pois  # a drive to one of these ends with the torso at the bench height
+        self.marker_at_poi = marker_at_poi  # T_world_marker of the station a POI serves: the head aims there
         self.planning = ArmPlanning(seed)
         self.grasp_flipped: dict[str, bool] = {}  # per arm: twin of the top-down grasp last used
         self.twin_wanted: dict[str, bool | None] = {}  # per arm: the one twin the next put's nest reaches
@@ -108,7 +112,10 @@ class RobotBehaviours:
         pose = self.known_poi(goal.poi)
         if run.read(lambda hardware: hardware.is_docked()):
             raise ActionAbort(ErrorCodes.DOCKED, "the robot is docked: undock first")
-        torso = torso_for_drive(run, self.motions, self.speed_scale(), goal.poi in self.station_pois)
+        to_station = goal.poi in self.station_pois
+        marker = self.marker_at_poi(goal.poi)
+        head = None if marker is None else partial(self.head_towards, pose, marker)
+        torso = posture_for_drive(run, self.motions, self.speed_scale(), to_station, head)
         try:
             # The drive has the whole progress: the torso moves beside it and nearly always stands
             # before the base arrives. With a share kept for the torso, the drive's last report said
@@ -124,9 +131,16 @@ class RobotBehaviours:
             if torso is not None:
                 torso.finish()
         except BaseException:
-            run.stop([None if torso is None else torso.execution])  # a cancelled drive stops the torso
+            run.stop([] if torso is None else list(torso.executions))  # a cancelled drive stops them
             raise
         return {}
+
+    def head_towards(
+        self, poi: tuple[float, float, float], T_world_marker: np.ndarray, torso_m: float
+    ) -> dict[str, float]:
+        """Head angles that look at a station's marker from its POI with the torso at `torso_m`."""
+        T_base_marker = np.linalg.inv(from_planar(*poi)) @ T_world_marker
+        return self.planning.head_towards({"torso_lift_joint": torso_m}, T_base_marker[:3, 3])
 
     def dock(self, run: GoalRun, _goal: Any) -> dict:
         if run.read(lambda hardware: hardware.is_docked()):

@@ -1,4 +1,5 @@
-"""The torso while the base drives: up to the bench height on the way to a station, down elsewhere.
+"""The torso and head while the base drives: to the bench height and towards the station's marker on
+the way to a station, the torso down elsewhere.
 
 Why: the final approach at a station waited for the torso's 0.17 m rise to the bench posture (2.7 s
 at 0.07 m/s) while the base covered its 0.22 m in 1.3 s; the torso set the approach's pace (the time
@@ -14,10 +15,18 @@ rise timed to the drive's end started late and kept the goal 0.3 to 0.8 s longer
 It starts once the drive moves, not before: while navigation plans, a moving torso keeps an
 unpaced simulation's clock running, which counted the planning's wall time as 0.4 s of robot time.
 A drive anywhere else (the dock, a free POI) lowers the torso to the travel height, as before.
+
+The head too: the final approach began by turning the head to the station's marker (0.8 rad of tilt,
+about 0.5 s) after the drive had stopped. A drive to a station's POI now turns it beside the drive
+to where the marker is seen from the POI with the torso at the bench height (the lab description's
+marker, the robot model's head), so the first look needs at most a small correction for where
+navigation really stopped. The head camera plays no part in navigation (the laser localises).
 Lives on: an rclpy executor thread (inside a navigation goal).
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
 
 from robot_port.execution import Execution
 from tiago_description.motion_library import MotionLibrary
@@ -39,38 +48,51 @@ def travel_torso_m(motions: MotionLibrary) -> float | None:
     return heights[-1] if heights else None
 
 
-class TorsoBesideDrive:
-    """The torso's move to `target_m` beside one drive, started once the drive moves (`poll`)."""
+class PostureBesideDrive:
+    """The torso's and head's moves to `targets` beside one drive, started once the drive moves
+    (`poll`); each group its own move, so the head is not held to the torso's 0.07 m/s."""
 
-    def __init__(self, run: GoalRun, target_m: float, speed_scale: float) -> None:
-        self.run, self.target_m, self.speed_scale = run, target_m, speed_scale
-        self.execution: Execution | None = None
+    def __init__(self, run: GoalRun, targets: dict[str, float], speed_scale: float) -> None:
+        self.run, self.targets, self.speed_scale = run, targets, speed_scale
+        self.executions: list[Execution] = []
 
     def poll(self, drive: Execution) -> None:
-        """Called while the drive runs: start the torso once the drive has a plan and moves."""
-        if self.execution is None and float(drive.remaining_s) > 0.0:
+        """Called while the drive runs: start the moves once the drive has a plan and moves."""
+        if not self.executions and float(drive.remaining_s) > 0.0:
             self.start()
 
     def start(self) -> None:
-        if self.execution is None:
-            self.execution = self.run.read(move_joints({TORSO: self.target_m}, self.speed_scale))
+        if self.executions:
+            return
+        groups = [{TORSO: self.targets[TORSO]}] if TORSO in self.targets else []
+        head = {name: value for name, value in self.targets.items() if name != TORSO}
+        groups += [head] if head else []
+        self.executions = [self.run.read(move_joints(group, self.speed_scale)) for group in groups]
 
     def finish(self) -> None:
-        """After the drive: follow the torso to its end (started now if the drive never moved)."""
+        """After the drive: follow the moves to their end (started now if the drive never moved)."""
         self.start()
-        assert self.execution is not None
-        self.run.follow(self.execution, span=(1.0, 1.0))
+        for execution in self.executions:
+            self.run.follow(execution, span=(1.0, 1.0))
 
 
-def torso_for_drive(
-    run: GoalRun, motions: MotionLibrary, speed_scale: float, to_station: bool
-) -> TorsoBesideDrive | None:
-    """The torso's move beside a drive to a station's POI (`to_station`) or elsewhere; None: it stays
-    (already there, or a low torso on the way elsewhere)."""
+def posture_for_drive(
+    run: GoalRun,
+    motions: MotionLibrary,
+    speed_scale: float,
+    to_station: bool,
+    head_at_station: Callable[[float], dict[str, float]] | None = None,
+) -> PostureBesideDrive | None:
+    """The torso's (and on the way to a station, the head's) moves beside a drive to a station's POI
+    (`to_station`) or elsewhere; `head_at_station(torso_m)` aims the head from the POI. None: all
+    stay (already there, or a low torso on the way elsewhere)."""
     target = bench_torso_m(motions) if to_station else travel_torso_m(motions)
-    if target is None:
-        return None
-    height = run.read(lambda hardware: hardware.joint_positions()[TORSO])
-    if abs(height - target) <= AT_HEIGHT_M or (not to_station and height < target):
-        return None
-    return TorsoBesideDrive(run, target, speed_scale * motions.speed_scale)
+    joints = run.read(lambda hardware: dict(hardware.joint_positions()))
+    targets: dict[str, float] = {}
+    if target is not None and not (
+        abs(joints[TORSO] - target) <= AT_HEIGHT_M or (not to_station and joints[TORSO] < target)
+    ):
+        targets[TORSO] = target
+    if to_station and head_at_station is not None:
+        targets.update(head_at_station(joints[TORSO] if target is None else target))
+    return PostureBesideDrive(run, targets, speed_scale * motions.speed_scale) if targets else None

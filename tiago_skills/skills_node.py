@@ -63,6 +63,10 @@ class RobotSkills:
             plate_widths=tuple(sorted({t.width for t in world.labware_types.values()})),
             # a drive to a station's POI raises the torso to the bench height (drive_posture)
             station_pois=frozenset(station.poi for station in world.stations),
+            # ... and turns the head to its marker (the lab description's)
+            marker_at_poi=lambda poi: next(
+                (station.T_world_marker() for station in self.world.stations if station.poi == poi), None
+            ),
         )
         self.marker_motion = MarkerMotionBehaviour(world, self.behaviours, motions.hotel)
         self.actions = RobotActionServers(

@@ -26,50 +26,18 @@ from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any, TextIO
 
+from sila_labware.benchmarks.failure_causes import CAUSES, classify_failure
 from sila_labware.benchmarks.levels import levels_json
 from sila_labware.benchmarks.stop_deadline import stop_within
+from sila_labware.benchmarks.trial_logs import drop_if_delivered, trial_logs_dir
 from sila_labware.client import remaining_time
 from sila_labware.client.remaining_time import RemainingCheck
-from sila_labware.deployment.demo import DISTURBED, MISPLACED, DemoReport, run_demo
+from sila_labware.deployment.demo import DemoReport, run_demo
+from sila_labware.deployment.port_blocks import reserve_port_block
 from sila_labware.deployment.processes import interrupt_requested
 from sila_labware.deployment.stack import Deployment, DeploymentOptions
 
 logger = logging.getLogger(__name__)
-
-CAUSES = ("positioning", "perception", "grasp", "navigation", "collision", "other")
-# Robot-side error codes (labware_interfaces/msg/ErrorCodes) -> failure cause of the success table;
-# COLLISION first: an unintended contact is a collision whatever the step (the plate may still arrive).
-CAUSE_BY_ERROR_CODE = {
-    "COLLISION": "collision",
-    "NAVIGATION_FAILED": "navigation",
-    "DOCKED": "navigation",
-    "MARKER_NOT_FOUND": "perception",
-    "NEST_NOT_SEEN": "perception",
-    "GRASP_FAILED": "grasp",
-    "PLATE_SLIPPED": "grasp",
-    "SLOT_EMPTY": "grasp",  # the plate the robot thought it had stowed is not on board
-    "IK_FAILED": "positioning",
-    "PLACE_FAILED": "positioning",
-    "NEST_OCCUPIED": "positioning",
-}
-BASE_MOTION_WORDS = ("driving to", "Dock", "Undock")
-
-
-def classify_failure(report: DemoReport) -> str:
-    """Failure cause of one trial from what the SiLA commands and the placement check said."""
-    error = report.error
-    if error.startswith(DISTURBED):  # another plate knocked out of place: an unintended contact
-        return "collision"
-    if error.startswith(MISPLACED):  # the commands succeeded, the physics check disagrees
-        return "positioning"
-    for code, cause in CAUSE_BY_ERROR_CODE.items():
-        if code in error:
-            return cause
-    if "MOTION_FAILED" in error:
-        return "navigation" if any(word in error for word in BASE_MOTION_WORDS) else "positioning"
-    if any(word in error for word in BASE_MOTION_WORDS):
-        return "navigation"
-    return "other"
 
 
 @dataclass
@@ -103,6 +71,7 @@ class CampaignOptions:
     layouts_dir: Path | None = None  # random layouts: trial seed S runs in layouts_dir/layout_S.yaml
     layouts_flag: str = "--random-layouts"  # the bench flag that drew them (for the replay line)
     real_robot: bool = False  # no lab-added sensors, Nav2's stop tolerances (bench --real-robot)
+    failed_logs_dir: Path | None = None  # a failed trial's robot-side logs stay in trial_SEED here
 
 
 def trial_stack(options: CampaignOptions, trial_seed: int, worker: int = 0) -> DeploymentOptions:
@@ -124,6 +93,7 @@ def trial_stack(options: CampaignOptions, trial_seed: int, worker: int = 0) -> D
         world=options.stack.world if layouts is None else layout_path(layouts, trial_seed),
         extra_sim_arguments=extra,
         port_base=options.stack.port_base + PORTS_PER_WORKER * worker,
+        log_dir=trial_logs_dir(options.failed_logs_dir, trial_seed) or options.stack.log_dir,
         domain_id=None if domain_id is None else domain_id + worker,
         prewarmed_robot_side=True,
     )
@@ -145,6 +115,8 @@ def run_trial(
     `stop_deadline_s` (a campaign's worker process only): if stopping the deployment takes longer,
     the kernel ends this process, which the campaign counts as a lost worker (`stop_deadline`)."""
     stack = trial_stack(options, trial_seed, worker)
+    # reserved on the host, as tests and a Ray node's trials reserve theirs (`port_blocks`)
+    stack = replace(stack, port_base=reserve_port_block(stack.port_base, PORTS_PER_WORKER, stack.host))
     if record_dir is not None:
         stack = replace(
             stack, extra_sim_arguments=[*stack.extra_sim_arguments, "--record-dir", str(record_dir)]
@@ -160,6 +132,7 @@ def run_trial(
         report = DemoReport(error=f"could not start: {type(error).__name__}: {error}")
     finally:
         stop_within(deployment.stop, stop_deadline_s)
+    drop_if_delivered(stack.log_dir if options.failed_logs_dir is not None else None, report.success)
     cause = "" if report.success else classify_failure(report)
     return TrialOutcome(
         seed=trial_seed,

@@ -23,6 +23,7 @@ from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
+from sila_labware.benchmarks import trial_logs
 from sila_labware.benchmarks.campaign import (
     PORTS_PER_WORKER,
     CampaignOptions,
@@ -106,7 +107,11 @@ def add_bench_arguments(bench: argparse.ArgumentParser) -> None:
     )
     bench.add_argument("--json", action="store_true", help="print one JSON object with the results")
     bench.add_argument(
-        "--report", type=Path, default=None, metavar="DIR", help="write PNG charts and run pictures"
+        "--report",
+        type=Path,
+        default=None,
+        metavar="DIR",
+        help="write PNG charts, run pictures and the failed trials' robot-side logs (failed-trial-logs/)",
     )
     bench.add_argument(
         "--level-scale", type=float, default=1.0, help="multiply every default level (0: no disturbance)"
@@ -243,6 +248,8 @@ def _run_and_report(args: argparse.Namespace, options: CampaignOptions) -> int:
     on_trial = None
     if args.report is not None:
         args.report.mkdir(parents=True, exist_ok=True)
+        if args.cluster is None and args.log_dir is None:  # on a cluster a node's files stay there
+            options.failed_logs_dir = args.report / trial_logs.FOLDER
         trials_log = args.report / "trials.jsonl"
         trials_log.write_text("")
 
@@ -277,6 +284,7 @@ def _run_and_report(args: argparse.Namespace, options: CampaignOptions) -> int:
     if args.report is not None:
         written = write_charts(summary, args.report)
         written += write_run_pictures(frames_dir, args.report) + kept
+        written += trial_logs.kept_trial_logs(options.failed_logs_dir)
         (args.report / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
         sys.stderr.write("report: " + ", ".join(str(path) for path in written) + "\n")
     interrupted = len(outcomes) < trials

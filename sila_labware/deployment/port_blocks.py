@@ -2,7 +2,8 @@
 
 Why: `bench --jobs` numbers its workers and gives worker k the ports from `--port-base` + 10 k; on a
 Ray cluster no one numbers the trials of one host (two Ray nodes may share a host, each with its
-own workers). So a trial's process reserves its block as ros_bridge.domain reserves a ROS domain:
+own workers); and tests pick free ports while a campaign may run beside them. So a trial's process
+(and a test's block, `claim_free_block`) reserves its block as ros_bridge.domain reserves a ROS domain:
 an exclusive lock on a file per block in the temp directory, held as long as the process lives
 (the OS drops it when the process ends, even on a crash), and only on a block whose ports are
 free right now (a server outside this scheme may hold some).
@@ -19,6 +20,13 @@ from typing import IO
 from sila_labware.servers.serving import port_is_free
 
 _held: dict[int, list[IO[bytes]]] = {}  # first port of the block this process holds -> its locks
+_claimed: list[IO[bytes]] = []  # locks of the blocks `claim_free_block` handed out (tests' servers)
+
+
+def _lock_directory(lock_dir: Path | None) -> Path:
+    directory = lock_dir or Path(tempfile.gettempdir()) / "sila-labware-ports"
+    directory.mkdir(parents=True, exist_ok=True)
+    return directory
 
 
 def reserve_port_block(first: int, size: int, host: str = "127.0.0.1", lock_dir: Path | None = None) -> int:
@@ -27,18 +35,32 @@ def reserve_port_block(first: int, size: int, host: str = "127.0.0.1", lock_dir:
     RuntimeError when every block up to port 65535 is taken."""
     if _held:
         return next(iter(_held))
-    directory = lock_dir or Path(tempfile.gettempdir()) / "sila-labware-ports"
-    directory.mkdir(parents=True, exist_ok=True)
+    directory = _lock_directory(lock_dir)
     for base in range(first, 65536 - size + 1, size):
-        locks = _lock_ports(directory, range(base, base + size))
-        if locks is None:
-            continue
-        if not all(port_is_free(host, port) for port in range(base, base + size)):
-            _release(locks)  # another run's servers may free these ports later
-            continue
-        _held[base] = locks
-        return base
+        locks = _locked_if_free(directory, range(base, base + size), host)
+        if locks is not None:
+            _held[base] = locks
+            return base
     raise RuntimeError(f"every block of {size} SiLA ports from {first} on is in use on this machine")
+
+
+def claim_free_block(ports: range, host: str = "127.0.0.1", lock_dir: Path | None = None) -> bool:
+    """Lock `ports` for this process (until it ends) if no other run holds any of them and all are
+    free now: a test's servers then never take the block a campaign's trial reserved between two
+    of its trials (seen: tests beside a campaign on the ports 54000 and up failed, passing alone)."""
+    locks = _locked_if_free(_lock_directory(lock_dir), ports, host)
+    if locks is None:
+        return False
+    _claimed.extend(locks)
+    return True
+
+
+def _locked_if_free(directory: Path, ports: range, host: str) -> list[IO[bytes]] | None:
+    locks = _lock_ports(directory, ports)
+    if locks is not None and not all(port_is_free(host, port) for port in ports):
+        _release(locks)  # another run's servers may free these ports later
+        return None
+    return locks
 
 
 def _lock_ports(directory: Path, ports: range) -> list[IO[bytes]] | None:

@@ -5,15 +5,16 @@ from __future__ import annotations
 import socket
 from collections.abc import Iterator
 
-from sila_labware.servers.serving import port_is_free
+from sila_labware.deployment.port_blocks import claim_free_block
 
 
 def free_port_base(count: int, candidates: range | None = None) -> int:
     """A port with ``count`` free ports on 127.0.0.1 from it on: the first such in ``candidates``,
-    else one the kernel hands out as ephemeral (so parallel runs rarely pick the same)."""
+    else one the kernel hands out as ephemeral (so parallel runs rarely pick the same). The block is
+    reserved for this process as a campaign's trials reserve theirs (`port_blocks`)."""
     for base in candidates if candidates is not None else _ephemeral_ports(50):
         ports = range(base, base + count)
-        if ports.stop <= 65536 and all(port_is_free("127.0.0.1", port) for port in ports):
+        if ports.stop <= 65536 and claim_free_block(ports):  # locked: a campaign beside never takes it
             return base
     raise RuntimeError(f"no block of {count} free ports found")
 

@@ -1,4 +1,5 @@
-"""The torso beside a drive: up to the bench height on the way to a station, down for elsewhere.
+"""The torso and head beside a drive: the torso up to the bench height and the head towards the
+station's marker on the way to a station, the torso down for elsewhere.
 
 Why: the final approach waited 2.7 s for the torso's rise while its base needed 1.3 s; the rise now
 goes beside the drive, which must not get longer for it. Real physics behind the hardware port,
@@ -10,11 +11,13 @@ from __future__ import annotations
 from collections.abc import Iterator
 from types import SimpleNamespace
 
+import numpy as np
 import pytest
 from labware_interfaces.action import NavigateToPoi
 
 from lab_description.world import DEFAULT_WORLD, load_world
 from tests.helpers.ros_processes import RosCaller
+from tiago_description import transforms as tf
 from tiago_description.motion_library import load_motions
 from tiago_sim.physics.simulation import Simulation
 from tiago_sim.sim_node.hardware import SimulatedHardware
@@ -46,6 +49,7 @@ def robot() -> Iterator[tuple[SimulatedHardware, RobotBehaviours]]:
         motions=load_motions(),
         speed_scale=lambda: 1.0,
         station_pois=frozenset(station.poi for station in world.stations),
+        marker_at_poi=lambda poi: next((s.T_world_marker() for s in world.stations if s.poi == poi), None),
     )
     try:
         hardware = SimulatedHardware(sim_thread, Navigation(caller.node, world, sim_thread))
@@ -85,6 +89,23 @@ def test_a_drive_to_a_station_raises_the_torso_beside_it_and_ends_with_it_at_the
     # the torso's 2.7 s rise went beside the drive: at its end the drive still had seconds to go
     risen_at = next(t for t, height in samples if height >= bench - 0.005)
     assert risen_at < end_s - 0.5, (risen_at - started, end_s - started)
+
+
+def test_a_drive_to_a_station_ends_with_the_head_on_its_marker(
+    robot: tuple[SimulatedHardware, RobotBehaviours],
+) -> None:
+    """The final approach's first look needs only the correction for where the base really stopped:
+    the head aimed from the POI is within a few hundredths of a radian of the aim from the pose the
+    robot believes it reached (it turned 0.8 rad there after the drive)."""
+    hardware, behaviours = robot
+    _navigate(hardware, behaviours, "station_b_work")
+    station = next(s for s in load_world(DEFAULT_WORLD).stations if s.poi == "station_b_work")
+    T_base_marker = np.linalg.inv(tf.from_planar(*hardware.pose_estimate())) @ station.T_world_marker()
+    joints = hardware.joint_positions()
+    aim = behaviours.planning.head_towards(dict(joints), T_base_marker[:3, 3])
+    for name, angle in aim.items():
+        assert abs(angle) > 0.1, aim  # a real turn away from the travel posture's straight ahead
+        assert joints[name] == pytest.approx(angle, abs=0.03), (name, joints[name], aim)
 
 
 def test_a_drive_elsewhere_lowers_the_torso_to_the_travel_height(

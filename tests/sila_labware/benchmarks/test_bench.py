@@ -22,7 +22,8 @@ import numpy as np
 import pytest
 
 from lab_description.world import load_world
-from sila_labware.benchmarks.campaign import CAUSES, PORTS_PER_WORKER, classify_failure
+from sila_labware.benchmarks.campaign import PORTS_PER_WORKER
+from sila_labware.benchmarks.failure_causes import CAUSES, classify_failure
 from sila_labware.benchmarks.levels import LEVEL_FLAGS, levels_json
 from sila_labware.deployment.demo import DemoReport
 from tests.helpers.sila_stack import free_port_base
@@ -156,6 +157,12 @@ def test_small_campaign_table_is_consistent_replays_and_reports(tmp_path: Path) 
         assert image is not None and image.shape[0] > 100 and image.shape[1] > 300, name
         assert image.std() > 10, f"{name} is blank"
     assert (report_dir / "run.gif").stat().st_size > 1000
+    kept = {
+        int(path.name.removeprefix("trial_")) for path in (report_dir / "failed-trial-logs").glob("trial_*")
+    }
+    assert kept == {failure["seed"] for failure in summary["failed_trials"]}, (
+        "a delivered trial's logs stayed"
+    )
     assert sorted((report_dir / "frames").glob("head_*.png")), "no head camera frame was recorded"
 
     replay = run_bench("--replay", str(SEED + 1), "--json")
@@ -243,3 +250,18 @@ def test_sigterm_stops_the_campaign_its_robot_side_and_summarises_what_was_done(
     assert summary["trials"] == 1 and summary["interrupted_after_trials"] == 1
     assert "interrupted: trial seed" in stderr
     assert not list(temp_dir.glob("sila-labware-bench-*")), "the run's CA directory outlived it"
+
+
+def test_a_failed_trials_robot_side_logs_stay_beside_the_report(tmp_path: Path) -> None:
+    """A failure that does not come back on replay can only be read from the run that failed."""
+    report_dir = tmp_path / "report"
+    # nests mounted 30 mm off their place: the plate misses its destination whatever the seed
+    done = run_bench(
+        "--trials", "1", "--seed", str(SEED), "--nest-error-mm", "30", "--json", "--report", str(report_dir)
+    )
+    summary = json.loads(done.stdout)
+    assert summary["successes"] == 0, summary["outcomes"]
+    logs = report_dir / "failed-trial-logs" / f"trial_{SEED}"
+    robot_side = (logs / "sim_node.log").read_text()
+    assert "tiago_skills.action_servers" in robot_side and "signal 15: shutting down" in robot_side
+    assert str(logs) in done.stderr  # the report names what it kept

@@ -7,7 +7,7 @@ import io
 from pathlib import Path
 
 from labware_model.holders import HotelSlot, Nest
-from sila_labware.benchmarks.campaign import classify_failure
+from sila_labware.benchmarks.failure_causes import classify_failure
 from sila_labware.deployment.demo import DISTURBED, run_demo
 from sila_labware.deployment.plate_names import plate_named_at, plates_at_start
 from tests.helpers.sila_stack import DEFAULT_WORLD, start_stack

@@ -10,6 +10,7 @@ from __future__ import annotations
 import socket
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 from sila_labware.testing.ports import free_port_base
@@ -59,3 +60,18 @@ def test_two_processes_get_blocks_of_their_own_and_a_busy_port_is_skipped(tmp_pa
     finally:
         release(two)
         release(three)
+
+
+def test_a_test_never_picks_the_ports_a_campaign_trial_holds() -> None:
+    """Tests pick free ports while a campaign may run beside them: a block a trial reserved (free
+    between two of its trials, or before its servers bind) is not free for a test."""
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        near = probe.getsockname()[1]
+    first = min(near, 65536 - 3 * SIZE)
+    trial, held = holder(first, Path(tempfile.gettempdir()) / "sila-labware-ports")
+    try:
+        picked = free_port_base(SIZE, candidates=range(held, held + 3 * SIZE, SIZE))
+        assert picked != held and picked in (held + SIZE, held + 2 * SIZE)
+    finally:
+        release(trial)
