@@ -50,9 +50,11 @@ def test_a_plate_that_does_not_fit_in_one_image_with_the_marker_is_measured_alon
     plate went down unmeasured off the nest (PLACE_FAILED). The plate is now framed and measured
     alone, against the nest the first sighting gave. Alone it sees 125 of the plate's 128 mm, near
     the detector's limit: on an idle machine it is measured and delivered (three replays of three);
-    in two loaded CI runs it was once not measured and once measured and placed off the nest. So the
-    test checks the look and that the place goes on with or without the measurement, as the log
-    says; the deliveries are the benchmarks page's."""
+    in two loaded CI runs it was once not measured and once measured and placed off the nest. The
+    miss is the lab's, not the measurement's: the nest row is drawn turned 0.58 deg and the marker
+    0.6 deg, which puts the nest about 7 mm from where the marker says, at the edge of what its ramps
+    capture (`measure-the-held-plate.md`). So the test checks the look and that the place goes on
+    with or without the measurement, as the log says; the deliveries are the benchmarks page's."""
     logs = tmp_path / "logs"
     world = str(FIXTURES / "marker_and_plate_apart.yaml")
     done = run_bench("--world", world, "--replay", "218178", "--json", "--log-dir", str(logs), "--verbose")
