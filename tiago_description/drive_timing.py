@@ -16,6 +16,9 @@ from tiago_description.robot_limits import active_limits
 from tiago_description.transforms import wrap_angle
 
 BLEND_ANGLE = 0.3  # rad: the drive starts once the heading is this close; the heading loop finishes the turn
+BRAKING_SHARE = (
+    0.8  # of the base's acceleration limit: the control law brakes at this, the ramp has room to follow
+)
 
 
 def rest_to_rest_s(amount: float, accel: float, max_speed: float) -> float:
@@ -63,7 +66,7 @@ def _turn_s(angle: float, start_speed: float, stop_short: float = 0.0) -> float:
     """A turn on the spot: speeding up at the angular limit, braking at 80 % of it."""
     limits = active_limits()
     accel = limits.angular_accel
-    return profile_s(angle, accel, accel * 0.8, limits.angular_speed, start_speed, stop_short)
+    return profile_s(angle, accel, accel * BRAKING_SHARE, limits.angular_speed, start_speed, stop_short)
 
 
 SETTLE_S = 0.1
@@ -88,7 +91,7 @@ def drive_duration_s(
     driving = profile_s(
         distance_m,
         active_limits().linear_accel,
-        active_limits().linear_accel * 0.8,
+        active_limits().linear_accel * BRAKING_SHARE,
         speed,
         start_speed=linear_speed,
     )

@@ -16,7 +16,7 @@ import numpy as np
 
 from lab_description.world import Pose2D
 from tiago_description import robot_model as rm
-from tiago_description.drive_timing import BLEND_ANGLE, drive_duration_s
+from tiago_description.drive_timing import BLEND_ANGLE, BRAKING_SHARE, drive_duration_s
 from tiago_description.robot_limits import active_limits
 from tiago_description.transforms import compose_planar as compose
 from tiago_description.transforms import invert_planar as invert
@@ -235,7 +235,7 @@ class DriveMotion(Motion):
     def _turn_rate(self, error: float) -> float:
         return math.copysign(
             _speed_for_distance(
-                abs(error), active_limits().angular_accel * 0.8, active_limits().angular_speed
+                abs(error), active_limits().angular_accel * BRAKING_SHARE, active_limits().angular_speed
             ),
             error,
         )
@@ -268,7 +268,9 @@ class DriveMotion(Motion):
             direction = -1.0 if self.reverse else 1.0
             heading_error = self._heading_error()
             along = distance * math.cos(heading_error)
-            v = direction * _speed_for_distance(along, active_limits().linear_accel * 0.8, self.speed)
+            v = direction * _speed_for_distance(
+                along, active_limits().linear_accel * BRAKING_SHARE, self.speed
+            )
             if along < POSITION_TOLERANCE * 0.5 or distance < POSITION_TOLERANCE * 0.5:
                 v = 0.0
                 if base.stopped() or abs(base.v) < 0.02:
