@@ -121,17 +121,15 @@ def run_trial(
         stack = replace(
             stack, extra_sim_arguments=[*stack.extra_sim_arguments, "--record-dir", str(record_dir)]
         )
-    deployment = Deployment(stack)
-    started = time.monotonic()
-    try:
-        deployment.start()
-        startup_s = time.monotonic() - started
-        report = run_demo(deployment, progress_stream=None)
-    except Exception as error:  # noqa: BLE001 - a trial that cannot even start is an "other" failure
-        startup_s = time.monotonic() - started
-        report = DemoReport(error=f"could not start: {type(error).__name__}: {error}")
-    finally:
-        stop_within(deployment.stop, stop_deadline_s)
+    report, startup_s, start_failed = _run_once(stack, stop_deadline_s)
+    lost_runs = []
+    if start_failed and not interrupt_requested():
+        # A robot side that never came up is the machine's fault, not the robot's (seen under load:
+        # rclpy's node creation hung in DDS for the whole start-up's 180 s): once more in a fresh
+        # deployment, and the outcome says so (`lost_runs`, listed apart in the table).
+        logger.warning("trial seed %d %s; running it once more", trial_seed, report.error)
+        lost_runs.append(report.error)
+        report, startup_s, _ = _run_once(stack, stop_deadline_s)
     drop_if_delivered(stack.log_dir if options.failed_logs_dir is not None else None, report.success)
     cause = "" if report.success else classify_failure(report)
     return TrialOutcome(
@@ -146,7 +144,27 @@ def run_trial(
         steps=[asdict(step) for step in report.steps],
         world=str(stack.world),
         remaining=[asdict(check) for check in report.remaining],
+        lost_runs=lost_runs,
     )
+
+
+def _run_once(stack: DeploymentOptions, stop_deadline_s: int | None) -> tuple[DemoReport, float, bool]:
+    """One deployment's start, transfer and stop: its report, start-up seconds and whether the start
+    itself failed."""
+    deployment = Deployment(stack)
+    started = time.monotonic()
+    start_failed = True
+    try:
+        deployment.start()
+        start_failed = False
+        startup_s = time.monotonic() - started
+        report = run_demo(deployment, progress_stream=None)
+    except Exception as error:  # noqa: BLE001 - a trial that cannot even start is an "other" failure
+        startup_s = time.monotonic() - started
+        report = DemoReport(error=f"could not start: {type(error).__name__}: {error}")
+    finally:
+        stop_within(deployment.stop, stop_deadline_s)
+    return report, startup_s, start_failed
 
 
 class CampaignProgress:
@@ -331,8 +349,8 @@ def format_table(summary: dict[str, Any]) -> str:
     if reruns:
         seeds = ", ".join(str(rerun["seed"]) for rerun in reruns)
         lines.append(
-            f"run again after their worker process died or their cluster node was lost (infrastructure, "
-            f"not counted as failures): "
+            f"run again after their worker process died, their cluster node was lost or their robot side "
+            f"did not start (infrastructure, not counted as failures): "
             f"{len(reruns)} trial(s), seeds {seeds}"
         )
     if "elapsed_wall_seconds" in summary and summary["trials"]:
