@@ -16,9 +16,8 @@ from tiago_description.robot_limits import active_limits
 from tiago_description.transforms import wrap_angle
 
 BLEND_ANGLE = 0.3  # rad: the drive starts once the heading is this close; the heading loop finishes the turn
-BRAKING_SHARE = (
-    0.8  # of the base's acceleration limit: the control law brakes at this, the ramp has room to follow
-)
+# Of the base's acceleration limit: the control law brakes at this, so the ramp has room to follow.
+BRAKING_SHARE = 0.8
 
 
 def rest_to_rest_s(amount: float, accel: float, max_speed: float) -> float:

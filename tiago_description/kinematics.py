@@ -272,3 +272,8 @@ def head_angles_towards(kinematics: RobotKinematics, joints: dict[str, float], t
         pan -= math.atan2(x, z)
         tilt -= math.atan2(y, z)
     return {"head_1_joint": pan, "head_2_joint": tilt}
+
+
+def head_aim(kinematics: RobotKinematics, joints: dict[str, float], target: np.ndarray) -> dict[str, float]:
+    """Pan and tilt, within the head's limits, that centre `target` (base_footprint) in the image."""
+    return within_head_limits(head_angles_towards(kinematics, joints, target))

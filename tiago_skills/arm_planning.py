@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from tiago_description.arm_clearance import ArmClearance, Box, Clearance, HeldBox
-from tiago_description.kinematics import RobotKinematics, head_angles_towards, within_head_limits
+from tiago_description.kinematics import RobotKinematics, head_aim
 from tiago_skills.joint_rrt import plan_around
 from tiago_skills.tool_path import plan_tool_path
 
@@ -89,7 +89,7 @@ class ArmPlanning:
     def head_towards(self, joint_positions: dict[str, float], target: np.ndarray) -> dict[str, float]:
         """Head angles (within their limits) that centre `target` (base_footprint) in the image."""
         with self._lock:
-            return within_head_limits(head_angles_towards(self._kinematics, joint_positions, target))
+            return head_aim(self._kinematics, joint_positions, target)
 
     def tool_pose(self, arm: str, joint_positions: dict[str, float]) -> np.ndarray:
         return self.frame_pose(joint_positions, f"gripper_{arm}_grasping_frame")

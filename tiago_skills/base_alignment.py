@@ -27,7 +27,7 @@ from lab_description.station_placement import nest_working_pose
 from lab_description.world import Station
 from robot_port.execution import Execution
 from tiago_description import transforms as tf
-from tiago_description.kinematics import RobotKinematics, head_angles_towards, within_head_limits
+from tiago_description.kinematics import RobotKinematics, head_aim, head_angles_towards, within_head_limits
 from tiago_skills.goal_run import ActionAbort, GoalRun
 from tiago_skills.joint_commands import move_joints
 
@@ -132,7 +132,7 @@ def align_base(
         # right of the base was out of the image, MARKER_NOT_FOUND with nothing disturbed.
         T_marker_at_work = tf.invert(tf.from_planar(*correction)) @ sighting.T_base_marker
         at_work = {**run.read(lambda hardware: dict(hardware.joint_positions())), **torso}
-        head_at_marker = within_head_limits(head_angles_towards(kinematics, at_work, T_marker_at_work[:3, 3]))
+        head_at_marker = head_aim(kinematics, at_work, T_marker_at_work[:3, 3])
         turning = run.read(move_joints(head_at_marker))
         background.append(turning)
         run.follow(lambda hardware: hardware.drive_to(goal_in_odom, ALIGN_SPEED), span=(0.2, 0.9))

@@ -22,13 +22,13 @@ from lab_description.serviceability import WORKING_CLEARANCE
 from robot_port.types import ARM_SIDES, JointTrajectory
 from tiago_description import robot_model as rm
 from tiago_description.motion_library import HOTEL_MOTIONS, MotionLibrary
-from tiago_description.transforms import from_planar
+from tiago_description.transforms import from_planar, invert
 from tiago_skills.arm_planning import ArmPlanning
 from tiago_skills.drive_estimate import planned_drive_s
 from tiago_skills.drive_posture import posture_for_drive
 from tiago_skills.goal_run import ActionAbort, GoalRun
 from tiago_skills.grasp_check import grasp_width_problem
-from tiago_skills.grasp_twins import FLIP_ABOUT_APPROACH, twin_times, twin_with_a_way_down
+from tiago_skills.grasp_twins import twin_pose, twin_times, twin_with_a_way_down
 from tiago_skills.joint_commands import keyframe_points, move_joints
 from tiago_skills.tool_path import tool_trajectory
 
@@ -139,7 +139,7 @@ class RobotBehaviours:
         self, poi: tuple[float, float, float], T_world_marker: np.ndarray, torso_m: float
     ) -> dict[str, float]:
         """Head angles that look at a station's marker from its POI with the torso at `torso_m`."""
-        T_base_marker = np.linalg.inv(from_planar(*poi)) @ T_world_marker
+        T_base_marker = invert(from_planar(*poi)) @ T_world_marker
         return self.planning.head_towards({"torso_lift_joint": torso_m}, T_base_marker[:3, 3])
 
     def dock(self, run: GoalRun, _goal: Any) -> dict:
@@ -200,7 +200,6 @@ class RobotBehaviours:
         down) if it reaches, else the one the arm reaches sooner (`move_s`: 0.2 m of torso takes
         2.9 s, 2.8 rad of an arm joint about 1.5 s).
         """
-        twins = {False: T_base_grasp, True: T_base_grasp @ FLIP_ABOUT_APPROACH}
         if self.holding.get(arm):
             order = [self.grasp_flipped.get(arm, False)]
         else:
@@ -210,7 +209,7 @@ class RobotBehaviours:
             wanted = None if self.holding.get(arm) else self.twin_wanted.get(arm)
             flip = wanted if wanted in duration else min(duration, key=duration.get)
             self.grasp_flipped[arm] = flip
-            return twins[flip]
+            return twin_pose(T_base_grasp, flip)
         raise ActionAbort(
             ErrorCodes.IK_FAILED, f"the {arm} arm cannot reach {np.round(T_base_grasp[:3, 3], 3)}"
         )

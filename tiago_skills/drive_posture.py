@@ -49,11 +49,11 @@ def travel_torso_m(motions: MotionLibrary) -> float | None:
 
 
 class PostureBesideDrive:
-    """The torso's and head's moves to `targets` beside one drive, started once the drive moves
+    """The moves of joint `groups` (the torso, the head) beside one drive, started once the drive moves
     (`poll`); each group its own move, so the head is not held to the torso's 0.07 m/s."""
 
-    def __init__(self, run: GoalRun, targets: dict[str, float], speed_scale: float) -> None:
-        self.run, self.targets, self.speed_scale = run, targets, speed_scale
+    def __init__(self, run: GoalRun, groups: list[dict[str, float]], speed_scale: float) -> None:
+        self.run, self.groups, self.speed_scale = run, groups, speed_scale
         self.executions: list[Execution] = []
 
     def poll(self, drive: Execution) -> None:
@@ -62,12 +62,8 @@ class PostureBesideDrive:
             self.start()
 
     def start(self) -> None:
-        if self.executions:
-            return
-        groups = [{TORSO: self.targets[TORSO]}] if TORSO in self.targets else []
-        head = {name: value for name, value in self.targets.items() if name != TORSO}
-        groups += [head] if head else []
-        self.executions = [self.run.read(move_joints(group, self.speed_scale)) for group in groups]
+        if not self.executions:
+            self.executions = [self.run.read(move_joints(group, self.speed_scale)) for group in self.groups]
 
     def finish(self) -> None:
         """After the drive: follow the moves to their end (started now if the drive never moved)."""
@@ -87,12 +83,12 @@ def posture_for_drive(
     (`to_station`) or elsewhere; `head_at_station(torso_m)` aims the head from the POI. None: all
     stay (already there, or a low torso on the way elsewhere)."""
     target = bench_torso_m(motions) if to_station else travel_torso_m(motions)
-    joints = run.read(lambda hardware: dict(hardware.joint_positions()))
-    targets: dict[str, float] = {}
+    height = run.read(lambda hardware: hardware.joint_positions()[TORSO])
+    groups = []
     if target is not None and not (
-        abs(joints[TORSO] - target) <= AT_HEIGHT_M or (not to_station and joints[TORSO] < target)
+        abs(height - target) <= AT_HEIGHT_M or (not to_station and height < target)
     ):
-        targets[TORSO] = target
+        groups.append({TORSO: target})
     if to_station and head_at_station is not None:
-        targets.update(head_at_station(joints[TORSO] if target is None else target))
-    return PostureBesideDrive(run, targets, speed_scale * motions.speed_scale) if targets else None
+        groups.append(head_at_station(height if target is None else target))
+    return PostureBesideDrive(run, groups, speed_scale * motions.speed_scale) if groups else None

@@ -40,7 +40,6 @@ from tiago_description.kinematics import CAMERA_FRAME, RobotKinematics
 from tiago_description.motion_library import HotelGrasp
 from tiago_skills.base_alignment import align_base, search_marker, working_pose
 from tiago_skills.behaviours import (
-    FLIP_ABOUT_APPROACH,
     TOOL_SPEED_FREE,
     TOOL_SPEED_INTO_POCKET,
     RobotBehaviours,
@@ -49,6 +48,7 @@ from tiago_skills.bench_exit import BenchExit
 from tiago_skills.bench_route import BenchRoute, held_plate_box, largest_labware
 from tiago_skills.gaze import marker_and_held_plate
 from tiago_skills.goal_run import ActionAbort, GoalRun
+from tiago_skills.grasp_twins import FLIP_ABOUT_APPROACH
 from tiago_skills.joint_commands import move_joints
 from tiago_skills.marker_sighting import MarkerSighting, pose_msg, same_place
 from tiago_skills.nest_looks import NestLooks

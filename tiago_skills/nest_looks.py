@@ -20,12 +20,7 @@ from labware_interfaces.msg import ErrorCodes
 
 from lab_description.world import World
 from tiago_description import transforms as tf
-from tiago_description.kinematics import (
-    CAMERA_FRAME,
-    RobotKinematics,
-    head_angles_towards,
-    within_head_limits,
-)
+from tiago_description.kinematics import CAMERA_FRAME, RobotKinematics, head_aim
 from tiago_skills.base_alignment import HEAD_JOINTS
 from tiago_skills.goal_run import ActionAbort, GoalRun
 from tiago_skills.joint_commands import move_joints
@@ -126,7 +121,7 @@ class NestLooks:
         plate with the head where it saw the marker (place_correction)."""
         joints = run.read(lambda hardware: dict(hardware.joint_positions()))
         back = {name: joints[name] for name in HEAD_JOINTS}
-        aim = within_head_limits(head_angles_towards(self.kinematics, joints, T_base_site[:3, 3]))
+        aim = head_aim(self.kinematics, joints, T_base_site[:3, 3])
         low = max(run.progress, 0.2)
         run.follow(move_joints(aim), span=(low, low + (1.0 - low) / 3))
         seen = look()

@@ -12,8 +12,9 @@ import numpy as np
 
 from tiago_description import transforms as tf
 from tiago_description.motion_library import HotelGrasp
-from tiago_skills.behaviours import FLIP_ABOUT_APPROACH, RobotBehaviours
+from tiago_skills.behaviours import RobotBehaviours
 from tiago_skills.goal_run import ActionAbort
+from tiago_skills.grasp_twins import FLIP_ABOUT_APPROACH
 
 log = logging.getLogger(__name__)
 TWINS = {False: "nominal", True: "turned"}

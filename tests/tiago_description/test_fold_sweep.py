@@ -19,7 +19,7 @@ from tiago_description.motion_library import load_motions
 ARM = "right"
 NEAREST_BENCH_EDGE_M = 0.36  # ahead of the base centre at a working pose
 HIGHEST_BENCH_TOP_M = 0.78
-FLIP = np.diag([1.0, -1.0, -1.0, 1.0])  # the grasp's twin (behaviours.FLIP_ABOUT_APPROACH)
+FLIP = np.diag([1.0, -1.0, -1.0, 1.0])  # the grasp's twin (grasp_twins.FLIP_ABOUT_APPROACH)
 
 
 @pytest.fixture(scope="module")

@@ -25,7 +25,6 @@ from tiago_description.arm_clearance import ArmClearance, Box, HeldBox
 from tiago_description.kinematics import RobotKinematics
 from tiago_description.motion_library import load_motions
 from tiago_sim.physics.simulation import Simulation
-from tiago_skills.behaviours import FLIP_ABOUT_APPROACH
 from tiago_skills.bench_route import (
     WAY_CLEARANCE_M,
     BenchRoute,
@@ -35,6 +34,7 @@ from tiago_skills.bench_route import (
     nest_labware_boxes,
     station_boxes,
 )
+from tiago_skills.grasp_twins import FLIP_ABOUT_APPROACH
 
 FIXTURE = Path(__file__).parent / "fixtures" / "board_beside_the_row.yaml"
 ARM = "right"

@@ -18,8 +18,9 @@ from lab_description.world import load_world
 from tests.tiago_sim.sim_node.test_fold_from_hotel import behaviours, benchtop_joints
 from tiago_description import transforms as tf
 from tiago_description.motion_library import load_motions
-from tiago_skills.behaviours import FLIP_ABOUT_APPROACH, RobotBehaviours
+from tiago_skills.behaviours import RobotBehaviours
 from tiago_skills.goal_run import ActionAbort
+from tiago_skills.grasp_twins import FLIP_ABOUT_APPROACH
 from tiago_skills.marker_motion import MarkerMotionBehaviour
 from tiago_skills.reachable import first_reachable, put_twin
 

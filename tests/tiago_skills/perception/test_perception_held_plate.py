@@ -17,7 +17,7 @@ from tiago_description import transforms as tf
 from tiago_description.motion_library import HotelGrasp
 from tiago_description.robot_model import PAD_WIDTH
 from tiago_sim.physics.camera import CameraIntrinsics, optical_frame_looking_at, render_rgbd
-from tiago_skills.behaviours import FLIP_ABOUT_APPROACH
+from tiago_skills.grasp_twins import FLIP_ABOUT_APPROACH
 from tiago_skills.perception.held_plate import HeldPlateSighting, locate_held_plate, site_points
 from tiago_skills.place_correction import HEAD_MOVED, place_shift
 
